@@ -122,7 +122,7 @@ class Camera:
             np.array_equal(self.world_from_camera, other.world_from_camera)
         )
 
-    __hash__ = None  # mutable-looking array field: cameras are compared, not hashed
+    __hash__ = None  # compared by value (including the pose array), so not hashable
 
     @property
     def camera_from_world(self) -> np.ndarray:

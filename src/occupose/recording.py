@@ -1,0 +1,454 @@
+"""The native recording folder: write it, open it, iterate its frames (DESIGN.md "Recording folder").
+
+::
+
+    <recording>/
+      recording.json               format, version, fps, num_frames, cameras
+      <camera>/depth/000000.png    16-bit PNG; depth = value * depth_scale metres; 0 = no measurement
+      <camera>/color/000000.png    optional 8-bit RGB, registered to the depth image
+      groundtruth.csv              optional: frame,person,joint,x,y,z[,visible] (world metres)
+
+A camera has colour when its ``color`` folder exists; it then has a colour image for
+every frame. Ground truth has one row per frame, person and known joint; joints with
+no row are unknown (NaN). Everything wrong with a recording is reported as a
+RecordingError (a ValueError) or FileNotFoundError whose message names the file.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator, Mapping, Sequence
+
+import numpy as np
+from PIL import Image, UnidentifiedImageError
+
+from occupose.camera import Camera, camera_from_dict
+from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS
+
+FORMAT = "occupose-recording"
+VERSION = 1
+SUPPORTED_VERSIONS: tuple[int, ...] = (1,)
+RECORDING_KEYS: tuple[str, ...] = ("format", "version", "fps", "num_frames", "cameras")
+GROUNDTRUTH_COLUMNS: tuple[str, ...] = ("frame", "person", "joint", "x", "y", "z", "visible")
+
+_JSON_NAME = "recording.json"
+_GROUNDTRUTH_NAME = "groundtruth.csv"
+
+
+class RecordingError(ValueError):
+    """A recording folder or one of its files is malformed; the message names the file."""
+
+
+def frame_filename(index: int) -> str:
+    """Name of frame ``index``'s image file: zero-padded to six digits, ``000042.png``."""
+    return f"{index:06d}.png"
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One time step of a recording.
+
+    index : int, frame number from 0
+    depth : dict camera name -> (H, W) float32, metres; 0 where there is no measurement
+    color : dict camera name -> (H, W, 3) uint8 RGB, for the cameras that have colour
+    """
+
+    index: int
+    depth: dict[str, np.ndarray]
+    color: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """Ground-truth skeletons of a recording.
+
+    joints : (T, P, 15, 3) float64, metres, world frame; NaN where unknown (person absent)
+    visible : (T, P, 15) bool; False where unknown
+    person_ids : tuple of P ints, increasing; person p of the arrays has id person_ids[p]
+    """
+
+    joints: np.ndarray
+    visible: np.ndarray
+    person_ids: tuple[int, ...]
+
+
+# ----------------------------------------------------------------------------- writing
+
+
+class RecordingWriter:
+    """Write a recording folder frame by frame.
+
+    ``path`` must not exist or be an empty folder. Every ``write_frame`` call gives a
+    depth image for every camera; the first call decides which cameras have colour and
+    later calls must give colour for the same cameras. ``close()`` (or leaving the
+    ``with`` block without an exception) writes ``recording.json``; a block left by an
+    exception leaves the folder without it, i.e. not a readable recording.
+    """
+
+    def __init__(self, path: str | os.PathLike, cameras: Sequence[Camera], fps: float):
+        self.path = Path(path)
+        cameras = list(cameras)
+        if not cameras or not all(isinstance(c, Camera) for c in cameras):
+            raise ValueError(f"cameras must be a non-empty list of Camera, got {cameras!r}")
+        names = [c.name for c in cameras]
+        if len(set(names)) != len(names):
+            raise ValueError(f"camera names must be unique, got {names}")
+        if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not math.isfinite(fps) or fps <= 0:
+            raise ValueError(f"fps must be a positive finite number, got {fps!r}")
+        if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
+            raise FileExistsError(f"{self.path}: recording folder must not exist or be empty")
+        self.cameras = cameras
+        self.fps = float(fps)
+        self.num_frames = 0
+        self._color_names: frozenset[str] | None = None
+        self._groundtruth_frames: int | None = None
+        self._closed = False
+        for camera in cameras:
+            (self.path / camera.name / "depth").mkdir(parents=True, exist_ok=True)
+
+    def __enter__(self) -> RecordingWriter:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise ValueError(f"{self.path}: recording writer is closed")
+
+    def write_frame(
+        self,
+        depths: Mapping[str, np.ndarray],
+        colors: Mapping[str, np.ndarray] | None = None,
+    ) -> None:
+        """Append one frame.
+
+        depths : dict camera name -> (H, W) uint16 raw depth (metres / depth_scale), every camera
+        colors : dict camera name -> (H, W, 3) uint8 RGB, or None for no colour
+        """
+        self._check_open()
+        colors = {} if colors is None else dict(colors)
+        expected = [c.name for c in self.cameras]
+        if set(depths) != set(expected):
+            raise ValueError(f"depths must have one image per camera {expected}, got {sorted(depths)}")
+        unknown = sorted(set(colors) - set(expected))
+        if unknown:
+            raise ValueError(f"colors given for unknown camera(s) {unknown}; cameras are {expected}")
+        if self._color_names is not None and set(colors) != self._color_names:
+            raise ValueError(
+                f"colors must be given for the same cameras in every frame: "
+                f"{sorted(self._color_names)} before, {sorted(colors)} in frame {self.num_frames}"
+            )
+        images = []
+        for camera in self.cameras:
+            size = (camera.height, camera.width)
+            depth = np.asarray(depths[camera.name])
+            if depth.dtype != np.uint16 or depth.shape != size:
+                raise ValueError(
+                    f"depth for camera {camera.name!r} must be uint16 {size} raw values "
+                    f"(see camera.raw_depth_from_metres), got {depth.dtype} {depth.shape}"
+                )
+            images.append((camera.name, "depth", np.ascontiguousarray(depth)))
+            if camera.name in colors:
+                color = np.asarray(colors[camera.name])
+                if color.dtype != np.uint8 or color.shape != size + (3,):
+                    raise ValueError(
+                        f"color for camera {camera.name!r} must be uint8 {size + (3,)} RGB, "
+                        f"got {color.dtype} {color.shape}"
+                    )
+                images.append((camera.name, "color", np.ascontiguousarray(color)))
+        name = frame_filename(self.num_frames)
+        for camera_name, kind, image in images:
+            folder = self.path / camera_name / kind
+            if kind == "color":
+                folder.mkdir(exist_ok=True)
+            Image.fromarray(image).save(folder / name, compress_level=1)
+        self._color_names = frozenset(colors)
+        self.num_frames += 1
+
+    def write_groundtruth(
+        self, joints: np.ndarray, visible: np.ndarray, person_ids: Sequence[int]
+    ) -> None:
+        """Write ``groundtruth.csv`` (once). Its frame count must match the recording's at close.
+
+        joints : (T, P, 15, 3) float, metres, world frame; NaN where unknown (person absent);
+            each joint is either fully finite or fully NaN
+        visible : (T, P, 15) bool
+        person_ids : P distinct ints
+        """
+        self._check_open()
+        if self._groundtruth_frames is not None:
+            raise ValueError(f"{self.path / _GROUNDTRUTH_NAME}: ground truth was already written")
+        joints = np.asarray(joints, dtype=np.float64)
+        visible = np.asarray(visible)
+        ids = [int(i) for i in person_ids]
+        if joints.ndim != 4 or joints.shape[2:] != (NUM_JOINTS, 3):
+            raise ValueError(f"joints must have shape (T, P, {NUM_JOINTS}, 3), got {joints.shape}")
+        if visible.dtype != bool or visible.shape != joints.shape[:3]:
+            raise ValueError(f"visible must be bool of shape {joints.shape[:3]}, got {visible.dtype} {visible.shape}")
+        if len(ids) != joints.shape[1] or len(set(ids)) != len(ids):
+            raise ValueError(f"person_ids must be {joints.shape[1]} distinct ints, got {list(person_ids)}")
+        finite = np.isfinite(joints)
+        known = finite.all(axis=-1)
+        if np.any(np.isinf(joints)) or np.any(finite.any(axis=-1) & ~known):
+            raise ValueError("joints must be fully finite or fully NaN per joint; some have inf or a partial NaN")
+        lines = [",".join(GROUNDTRUTH_COLUMNS)]
+        for t, p, j in zip(*np.nonzero(known)):
+            x, y, z = joints[t, p, j]
+            lines.append(f"{t},{ids[p]},{JOINTS[j]},{x:.5f},{y:.5f},{z:.5f},{int(visible[t, p, j])}")
+        (self.path / _GROUNDTRUTH_NAME).write_text("\n".join(lines) + "\n")
+        self._groundtruth_frames = joints.shape[0]
+
+    def close(self) -> None:
+        """Write ``recording.json``. Calling it again does nothing."""
+        if self._closed:
+            return
+        if self._groundtruth_frames is not None and self._groundtruth_frames != self.num_frames:
+            raise ValueError(
+                f"{self.path / _GROUNDTRUTH_NAME}: ground truth has {self._groundtruth_frames} frames, "
+                f"the recording {self.num_frames}"
+            )
+        # one camera per line, as in DESIGN.md, rather than one number per line
+        head = json.dumps({"format": FORMAT, "version": VERSION, "fps": self.fps, "num_frames": self.num_frames})
+        cameras = ",\n  ".join(json.dumps(c.to_dict()) for c in self.cameras)
+        (self.path / _JSON_NAME).write_text(f'{head[:-1]},\n "cameras": [\n  {cameras}\n ]}}\n')
+        self._closed = True
+
+
+# ----------------------------------------------------------------------------- reading
+
+
+def _read_header(file: Path) -> tuple[float, int, list[Camera]]:
+    if not file.is_file():
+        raise FileNotFoundError(f"{file}: no such file; a recording folder needs a {_JSON_NAME}")
+    try:
+        header = json.loads(file.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as error:
+        raise RecordingError(f"{file}: not a UTF-8 text file ({error.reason})") from None
+    except json.JSONDecodeError as error:
+        raise RecordingError(
+            f"{file}: not valid JSON ({error.msg} at line {error.lineno} column {error.colno})"
+        ) from None
+    if not isinstance(header, dict):
+        raise RecordingError(f"{file}: expected a JSON object, got {type(header).__name__}")
+    if header.get("format") != FORMAT:
+        raise RecordingError(f"{file}: \"format\" must be {FORMAT!r}, got {header.get('format')!r}")
+    version = header.get("version")
+    if isinstance(version, bool) or version not in SUPPORTED_VERSIONS:
+        raise RecordingError(
+            f"{file}: unsupported version {version!r}; this occupose reads versions {list(SUPPORTED_VERSIONS)}"
+        )
+    missing = [k for k in RECORDING_KEYS if k not in header]
+    if missing:
+        raise RecordingError(f"{file}: missing key(s) {missing}; a recording needs {list(RECORDING_KEYS)}")
+    unknown = sorted(set(header) - set(RECORDING_KEYS))
+    if unknown:
+        raise RecordingError(f"{file}: unknown key(s) {unknown}; a recording has exactly {list(RECORDING_KEYS)}")
+    fps, num_frames, entries = header["fps"], header["num_frames"], header["cameras"]
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not math.isfinite(fps) or fps <= 0:
+        raise RecordingError(f"{file}: \"fps\" must be a positive number, got {fps!r}")
+    if isinstance(num_frames, bool) or not isinstance(num_frames, int) or num_frames < 0:
+        raise RecordingError(f"{file}: \"num_frames\" must be a non-negative integer, got {num_frames!r}")
+    if not isinstance(entries, list) or not entries:
+        raise RecordingError(f"{file}: \"cameras\" must be a non-empty list, got {entries!r}")
+    cameras = []
+    for i, entry in enumerate(entries):
+        try:
+            cameras.append(camera_from_dict(entry, source=f"{file}: cameras[{i}]"))
+        except ValueError as error:
+            raise RecordingError(str(error)) from None
+    names = [c.name for c in cameras]
+    if len(set(names)) != len(names):
+        raise RecordingError(f"{file}: camera names must be unique, got {names}")
+    return float(fps), num_frames, cameras
+
+
+def _check_frame_files(folder: Path, num_frames: int) -> None:
+    if not folder.is_dir():
+        raise FileNotFoundError(f"{folder}: no such folder; it should hold the camera's {num_frames} frames")
+    present = set(os.listdir(folder))
+    for i in range(num_frames):
+        if frame_filename(i) not in present:
+            raise FileNotFoundError(
+                f"{folder / frame_filename(i)}: missing frame file (recording has {num_frames} frames)"
+            )
+
+
+def _read_png(file: Path, mode: str, shape: tuple[int, ...], what: str) -> np.ndarray:
+    try:
+        with Image.open(file) as image:
+            if image.format != "PNG" or image.mode != mode:
+                raise RecordingError(
+                    f"{file}: expected {what} PNG (mode {mode!r}), got a {image.format} image of mode {image.mode!r}"
+                )
+            array = np.asarray(image)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{file}: missing frame file") from None
+    except (UnidentifiedImageError, OSError, SyntaxError) as error:
+        raise RecordingError(f"{file}: not a readable PNG image ({error})") from None
+    if array.shape != shape:
+        raise RecordingError(f"{file}: image is {array.shape[1]}x{array.shape[0]}, the camera is {shape[1]}x{shape[0]}")
+    return array
+
+
+class Recording:
+    """An open recording folder (read-only; images are read on demand).
+
+    Attributes: ``path`` (Path), ``fps`` (float), ``num_frames`` (int), ``cameras``
+    (list of Camera). Opening checks ``recording.json`` and that every frame file exists.
+    """
+
+    def __init__(self, path: str | os.PathLike):
+        self.path = Path(path)
+        if not self.path.is_dir():
+            raise FileNotFoundError(f"{self.path}: no such recording folder")
+        self.fps, self.num_frames, self.cameras = _read_header(self.path / _JSON_NAME)
+        self._by_name = {c.name: c for c in self.cameras}
+        self._color_names = []
+        for camera in self.cameras:
+            _check_frame_files(self.path / camera.name / "depth", self.num_frames)
+            if (self.path / camera.name / "color").exists():
+                _check_frame_files(self.path / camera.name / "color", self.num_frames)
+                self._color_names.append(camera.name)
+
+    def __repr__(self) -> str:
+        return (
+            f"Recording({str(self.path)!r}, {self.num_frames} frames at {self.fps:g} fps, "
+            f"cameras {list(self._by_name)})"
+        )
+
+    def camera(self, name: str) -> Camera:
+        """The camera called ``name``."""
+        try:
+            return self._by_name[name]
+        except KeyError:
+            raise RecordingError(f"{self.path}: no camera {name!r}; cameras are {list(self._by_name)}") from None
+
+    @property
+    def color_cameras(self) -> tuple[str, ...]:
+        """Names of the cameras that have colour images."""
+        return tuple(self._color_names)
+
+    def _check_index(self, index: int) -> int:
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not 0 <= index < self.num_frames:
+            raise RecordingError(
+                f"{self.path}: frame index {index!r} out of range; the recording has frames 0..{self.num_frames - 1}"
+            )
+        return int(index)
+
+    def depth_raw(self, index: int, name: str) -> np.ndarray:
+        """(H, W) uint16 raw depth of camera ``name`` at frame ``index`` (metres = value * depth_scale)."""
+        camera = self.camera(name)
+        file = self.path / name / "depth" / frame_filename(self._check_index(index))
+        return _read_png(file, "I;16", (camera.height, camera.width), "a 16-bit grayscale depth")
+
+    def color(self, index: int, name: str) -> np.ndarray:
+        """(H, W, 3) uint8 RGB image of camera ``name`` at frame ``index``."""
+        camera = self.camera(name)
+        if name not in self._color_names:
+            raise RecordingError(f"{self.path / name}: camera {name!r} has no color folder")
+        file = self.path / name / "color" / frame_filename(self._check_index(index))
+        return _read_png(file, "RGB", (camera.height, camera.width, 3), "an 8-bit RGB colour")
+
+    def frame(self, index: int) -> Frame:
+        """Frame ``index``: depth in float32 metres for every camera, colour where there is any."""
+        index = self._check_index(index)
+        depth = {
+            c.name: (self.depth_raw(index, c.name) * c.depth_scale).astype(np.float32) for c in self.cameras
+        }
+        color = {name: self.color(index, name) for name in self._color_names}
+        return Frame(index=index, depth=depth, color=color)
+
+    def frames(self) -> Iterator[Frame]:
+        """Iterate over all frames in order, reading each when it is reached."""
+        for index in range(self.num_frames):
+            yield self.frame(index)
+
+    @property
+    def has_groundtruth(self) -> bool:
+        """Whether the recording has a ``groundtruth.csv``."""
+        return (self.path / _GROUNDTRUTH_NAME).is_file()
+
+    def groundtruth(self) -> GroundTruth:
+        """Read ``groundtruth.csv`` into arrays over all ``num_frames`` frames.
+
+        A missing ``visible`` column means every listed joint is visible. Persons are
+        those with at least one row, in increasing id order.
+        """
+        file = self.path / _GROUNDTRUTH_NAME
+        if not file.is_file():
+            raise FileNotFoundError(f"{file}: no such file; this recording has no ground truth")
+        try:
+            rows = _read_groundtruth_rows(file, self.num_frames)
+        except (UnicodeDecodeError, csv.Error) as error:
+            raise RecordingError(f"{file}: not a readable UTF-8 CSV file ({error})") from None
+        person_ids = tuple(sorted({person for _, person, *_ in rows}))
+        column = {person: p for p, person in enumerate(person_ids)}
+        joints = np.full((self.num_frames, len(person_ids), NUM_JOINTS, 3), np.nan)
+        visible = np.zeros(joints.shape[:3], dtype=bool)
+        for frame, person, joint, xyz, flag in rows:
+            joints[frame, column[person], joint] = xyz
+            visible[frame, column[person], joint] = flag
+        return GroundTruth(joints=joints, visible=visible, person_ids=person_ids)
+
+
+def _read_groundtruth_rows(file: Path, num_frames: int) -> list[tuple[int, int, int, tuple[float, float, float], bool]]:
+    """Parse and check ``groundtruth.csv``: rows of (frame, person, joint index, (x, y, z), visible)."""
+    with open(file, newline="", encoding="utf-8") as handle:
+        reader = csv.reader(handle)
+        header = next(reader, None)
+        columns = [c.strip() for c in header] if header is not None else []
+        if columns not in (list(GROUNDTRUTH_COLUMNS), list(GROUNDTRUTH_COLUMNS[:-1])):
+            raise RecordingError(
+                f"{file}: bad header {columns}; expected columns {','.join(GROUNDTRUTH_COLUMNS)} (visible optional)"
+            )
+        has_visible = len(columns) == len(GROUNDTRUTH_COLUMNS)
+        rows = []
+        seen = set()
+        for line, values in enumerate(reader, start=2):
+            if not values:
+                continue
+            where = f"{file} line {line}"
+            if len(values) != len(columns):
+                raise RecordingError(f"{where}: expected {len(columns)} values, got {len(values)}: {values}")
+            try:
+                frame, person = int(values[0]), int(values[1])
+            except ValueError:
+                raise RecordingError(
+                    f"{where}: frame and person must be integers, got {values[0]!r}, {values[1]!r}"
+                ) from None
+            if not 0 <= frame < num_frames:
+                raise RecordingError(
+                    f"{where}: frame {frame} out of range; the recording has frames 0..{num_frames - 1}"
+                )
+            name = values[2].strip()
+            if name not in JOINT_INDEX:
+                raise RecordingError(f"{where}: unknown joint {name!r}; valid joints: {', '.join(JOINTS)}")
+            try:
+                xyz = tuple(float(v) for v in values[3:6])
+            except ValueError:
+                raise RecordingError(f"{where}: x, y, z must be numbers, got {values[3:6]}") from None
+            if not all(math.isfinite(v) for v in xyz):
+                raise RecordingError(f"{where}: x, y, z must be finite, got {values[3:6]}")
+            flag = True
+            if has_visible:
+                if values[6].strip() not in ("0", "1"):
+                    raise RecordingError(f"{where}: visible must be 0 or 1, got {values[6]!r}")
+                flag = values[6].strip() == "1"
+            key = (frame, person, JOINT_INDEX[name])
+            if key in seen:
+                raise RecordingError(f"{where}: duplicate row for frame {frame}, person {person}, joint {name}")
+            seen.add(key)
+            rows.append((frame, person, JOINT_INDEX[name], xyz, flag))
+    return rows
+
+
+def open_recording(path: str | os.PathLike) -> Recording:
+    """Open the recording folder at ``path`` (same as ``Recording(path)``)."""
+    return Recording(path)
