@@ -400,3 +400,22 @@ def test_all_joint_names_are_accepted(rec):
     rows = "".join(f"0,1,{name},0,0,{i},1\n" for i, name in enumerate(JOINTS))
     (rec / "groundtruth.csv").write_text("frame,person,joint,x,y,z,visible\n" + rows)
     np.testing.assert_array_equal(Recording(rec).groundtruth().joints[0, 0, :, 2], np.arange(15))
+
+
+def test_real_azure_kinect_frame_round_trips(tmp_path):
+    from occupose.camera import camera_preset, points_from_depth
+    from occupose.paths import shared_data_dir
+
+    data = shared_data_dir()
+    file = None if data is None else data / "sensors" / "azure_kinect" / "depth_frame0_mm.npy"
+    if file is None or not file.is_file():
+        pytest.skip("shared sensor data (../shared/data/sensors or OCCUPOSE_DATA) not present")
+    depth = np.load(file)
+    camera = camera_preset("azure_nfov")
+    with RecordingWriter(tmp_path / "azure", [camera], fps=30.0) as writer:
+        writer.write_frame({"cam0": depth})
+    recording = Recording(tmp_path / "azure")
+    np.testing.assert_array_equal(recording.depth_raw(0, "cam0"), depth)
+    points, pixels = points_from_depth(recording.frame(0).depth["cam0"], camera, frame="camera")
+    assert pixels.size == np.count_nonzero(depth)  # 23.5 % of the pixels are invalid zeros
+    assert 0.16 < points[:, 2].min() and points[:, 2].max() < 3.7
