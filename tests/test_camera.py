@@ -233,12 +233,12 @@ def test_presets_carry_the_documented_sensor_values():
     assert CAMERA_PRESETS["realsense_d435"] == SensorSpec(
         "realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "stereo")
     azure = sensor_spec("azure_nfov")
-    assert (azure.width, azure.height, azure.cx, azure.cy, azure.noise) == (640, 576, 319.5, 287.5, "tof")
+    assert (azure.width, azure.height, azure.cx, azure.cy, azure.noise) == (640, 576, 332.78, 304.83, "tof")
     assert (azure.near, azure.far) == (0.5, 3.86)
     # 75 x 65 degree field of view
-    assert math.degrees(2 * math.atan(320 / azure.fx)) == pytest.approx(75.0)
-    assert math.degrees(2 * math.atan(288 / azure.fy)) == pytest.approx(65.0)
-    assert azure.fx == pytest.approx(417.03, abs=0.01) and azure.fy == pytest.approx(452.07, abs=0.01)
+    # factory calibration: normalised fx 0.49278 of the 1024-px sensor; pinhole FOV ~65 x 59 deg
+    assert azure.fx == pytest.approx(0.4927809 * 1024, abs=0.01) and azure.fy == pytest.approx(0.4929028 * 1024, abs=0.01)
+    assert math.degrees(2 * math.atan(320 / azure.fx)) == pytest.approx(64.8, abs=0.1)
 
 
 def test_camera_preset_builds_a_camera():

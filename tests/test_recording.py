@@ -128,6 +128,25 @@ def test_recording_without_colour_or_groundtruth(tmp_path, rng):
         recording.groundtruth()
 
 
+def test_label_images_round_trip_and_errors(tmp_path, rng):
+    camera = make_cameras()[0]
+    person = rng.integers(0, 3, size=(6, 8)).astype(np.uint8)
+    part = rng.integers(0, 16, size=(6, 8)).astype(np.uint8)
+    with RecordingWriter(tmp_path / "synth", [camera], fps=30) as writer:
+        writer.write_frame({"cam0": np.zeros((6, 8), np.uint16)}, labels={"cam0": {"person": person, "part": part}})
+    recording = Recording(tmp_path / "synth")
+    np.testing.assert_array_equal(recording.label(0, "cam0", "person"), person)
+    np.testing.assert_array_equal(recording.label(0, "cam0", "part"), part)
+    with pytest.raises(ValueError, match="unknown label kind 'skin'; valid: person, part"):
+        recording.label(0, "cam0", "skin")
+    with RecordingWriter(tmp_path / "plain", [camera], fps=30) as writer:
+        writer.write_frame({"cam0": np.zeros((6, 8), np.uint16)})
+        with pytest.raises(ValueError, match="label image 'part' for camera 'cam0' must be .* uint8"):
+            writer.write_frame({"cam0": np.zeros((6, 8), np.uint16)}, labels={"cam0": {"part": part.astype(np.int32)}})
+    with pytest.raises(RecordingError, match="has no 'person' label images"):
+        Recording(tmp_path / "plain").label(0, "cam0", "person")
+
+
 def test_writer_with_exception_leaves_no_header(tmp_path, rng):
     with pytest.raises(RuntimeError):
         with RecordingWriter(tmp_path / "r", make_cameras(), 30.0) as writer:

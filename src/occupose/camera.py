@@ -364,18 +364,17 @@ class SensorSpec:
     noise: str
 
 
-#: Depth sensors by name. Intrinsics from ../shared/data/README.md (Azure Kinect NFOV
-#: derived from its nominal 75 x 65 degree field of view); ranges from the makers' specs.
+#: Depth sensors by name. Intrinsics from ../shared/data/README.md; Azure Kinect NFOV
+#: unbinned from the real factory calibration in ../shared/data/sensors/azure_kinect
+#: (normalised cx, cy, fx, fy of the 1024 x 1024 depth sensor, cropped to 640 x 576; the
+#: nominal 75 x 65 degree field of view includes lens distortion a pinhole cannot carry).
+#: Ranges from the makers' specs.
 CAMERA_PRESETS: dict[str, SensorSpec] = {
     spec.name: spec
     for spec in (
         SensorSpec("kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.8, 4.0, "structured_light"),
         SensorSpec("kinect_v2", 512, 424, 365.5, 365.5, 254.9, 205.4, 0.5, 4.5, "tof"),
-        SensorSpec(
-            "azure_nfov", 640, 576,
-            320.0 / math.tan(math.radians(37.5)), 288.0 / math.tan(math.radians(32.5)),
-            319.5, 287.5, 0.5, 3.86, "tof",
-        ),
+        SensorSpec("azure_nfov", 640, 576, 504.61, 504.73, 332.78, 304.83, 0.5, 3.86, "tof"),
         SensorSpec("realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "stereo"),
     )
 }

@@ -40,6 +40,10 @@ _JSON_NAME = "recording.json"
 _GROUNDTRUTH_NAME = "groundtruth.csv"
 
 
+#: Synthetic label images a recording may carry beside depth and colour.
+LABEL_KINDS = ("person", "part")
+
+
 class RecordingError(ValueError):
     """A recording folder or one of its files is malformed; the message names the file."""
 
@@ -126,14 +130,18 @@ class RecordingWriter:
         self,
         depths: Mapping[str, np.ndarray],
         colors: Mapping[str, np.ndarray] | None = None,
+        labels: Mapping[str, Mapping[str, np.ndarray]] | None = None,
     ) -> None:
         """Append one frame.
 
         depths : dict camera name -> (H, W) uint16 raw depth (metres / depth_scale), every camera
         colors : dict camera name -> (H, W, 3) uint8 RGB, or None for no colour
+        labels : optional synthetic label images, dict camera name -> {kind: (H, W) uint8}
+            with kind in LABEL_KINDS ("person": person id, 0 = none; "part": body-part label)
         """
         self._check_open()
         colors = {} if colors is None else dict(colors)
+        labels = {} if labels is None else dict(labels)
         expected = [c.name for c in self.cameras]
         if set(depths) != set(expected):
             raise ValueError(f"depths must have one image per camera {expected}, got {sorted(depths)}")
@@ -163,10 +171,18 @@ class RecordingWriter:
                         f"got {color.dtype} {color.shape}"
                     )
                 images.append((camera.name, "color", np.ascontiguousarray(color)))
+            for kind, label in labels.get(camera.name, {}).items():
+                label = np.asarray(label)
+                if kind not in LABEL_KINDS or label.dtype != np.uint8 or label.shape != size:
+                    raise ValueError(
+                        f"label image {kind!r} for camera {camera.name!r} must be one of {LABEL_KINDS} "
+                        f"as uint8 {size}, got {label.dtype} {label.shape}"
+                    )
+                images.append((camera.name, kind, np.ascontiguousarray(label)))
         name = frame_filename(self.num_frames)
         for camera_name, kind, image in images:
             folder = self.path / camera_name / kind
-            if kind == "color":
+            if kind != "depth":
                 folder.mkdir(exist_ok=True)
             Image.fromarray(image).save(folder / name, compress_level=1)
         self._color_names = frozenset(colors)
@@ -355,6 +371,20 @@ class Recording:
             raise RecordingError(f"{self.path / name}: camera {name!r} has no color folder")
         file = self.path / name / "color" / frame_filename(self._check_index(index))
         return _read_png(file, "RGB", (camera.height, camera.width, 3), "an 8-bit RGB colour")
+
+    def label(self, index: int, name: str, kind: str) -> np.ndarray:
+        """(H, W) uint8 synthetic label image (``kind`` in LABEL_KINDS) of camera ``name``.
+
+        Only synthetic recordings have them: ``<camera>/person/`` holds the person id of
+        every pixel (0 = none), ``<camera>/part/`` its body-part label (occupose.joints.PARTS).
+        """
+        camera = self.camera(name)
+        if kind not in LABEL_KINDS:
+            raise ValueError(f"unknown label kind {kind!r}; valid: {', '.join(LABEL_KINDS)}")
+        file = self.path / name / kind / frame_filename(self._check_index(index))
+        if not file.parent.is_dir():
+            raise RecordingError(f"{file.parent}: this recording has no {kind!r} label images (only synthetic ones do)")
+        return _read_png(file, "L", (camera.height, camera.width), f"an 8-bit {kind} label")
 
     def frame(self, index: int) -> Frame:
         """Frame ``index``: depth in float32 metres for every camera, colour where there is any."""
