@@ -1,0 +1,141 @@
+"""Sensor noise models: measured statistics against the stated formulas, shadows, edges, seeds."""
+
+import numpy as np
+import pytest
+
+from occupose.synth.noise import (
+    KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, NOISE_MODELS, apply_noise,
+    depth_std, projector_shadows,
+)
+
+FX = 525.0
+
+
+def _step_image(near=1.5, far=3.0, cols=(200, 300), shape=(60, 400)):
+    """A wall at ``far`` with a foreground slab at ``near`` over columns [cols[0], cols[1])."""
+    depth = np.full(shape, far, np.float32)
+    depth[:, cols[0]:cols[1]] = near
+    return depth
+
+
+@pytest.mark.parametrize("model", ["structured_light", "tof"])
+@pytest.mark.parametrize("z", [2.0, 4.0])
+def test_flat_wall_std_matches_the_stated_formula(model, z):
+    wall = np.full((240, 320), z, np.float32)
+    noisy = apply_noise(wall, model, np.random.default_rng(1), fx=FX)
+    measured = noisy[noisy > 0].std()
+    assert measured == pytest.approx(depth_std(z, model), rel=0.2)
+    assert abs(noisy[noisy > 0].mean() - z) < 0.5 * depth_std(z, model)  # no gross bias
+
+
+def test_stated_std_values():
+    assert depth_std(2.0, "structured_light") == pytest.approx(0.0012 + 0.0019 * 1.6**2)
+    assert depth_std(2.0, "tof") == pytest.approx(0.0017)
+    assert depth_std(3.0, "none") == 0.0
+    z = np.linspace(0.5, 3.86, 50)
+    assert np.all(depth_std(z, "tof") <= 0.017)  # the Azure Kinect's specified random error
+    assert depth_std(z, "structured_light").shape == z.shape
+    with pytest.raises(ValueError, match="valid names"):
+        depth_std(1.0, "lidar")
+
+
+def test_structured_light_is_quantised_in_raw_disparity_units():
+    rng = np.random.default_rng(2)
+    depth = rng.uniform(0.6, 4.5, size=(50, 50)).astype(np.float32)
+    noisy = apply_noise(depth, "structured_light", rng, fx=FX, shadows=False, dropout=0.0)
+    raw = (KINECT_V1_INVERSE_DEPTH_OFFSET - 1.0 / noisy.astype(np.float64)) / KINECT_V1_INVERSE_DEPTH_STEP
+    np.testing.assert_allclose(raw, np.round(raw), atol=1e-3)  # float32 storage rounding only
+    # So the depth step between neighbouring levels is about 0.00307 z^2 (1.2 cm at 2 m).
+    levels = np.sort(np.unique(apply_noise(np.full((100, 100), 2.0), "structured_light", rng, fx=FX)))
+    levels = levels[levels > 0]
+    assert np.diff(levels).min() == pytest.approx(0.00307 * 4, rel=0.05)
+
+
+@pytest.mark.parametrize("baseline", [0.075, -0.075])
+def test_projector_shadows_fall_beside_the_foreground(baseline):
+    depth = _step_image()
+    noisy = apply_noise(depth, "structured_light", np.random.default_rng(3), fx=FX, baseline=baseline, dropout=0.0)
+    width = FX * abs(baseline) * (1 / 1.5 - 1 / 3.0)  # 13.1 pixels
+    band = int(np.floor(width))
+    if baseline > 0:  # projector to the right: shadow left of the slab
+        shadow, lit = noisy[:, 200 - band:200], noisy[:, 300:300 + 2 * band]
+        outside = noisy[:, 200 - band - 3:200 - band]
+    else:
+        shadow, lit = noisy[:, 300:300 + band], noisy[:, 200 - 2 * band:200]
+        outside = noisy[:, 300 + band:300 + band + 3]
+    assert np.all(shadow == 0)
+    assert np.all(lit > 0) and np.all(outside > 0)
+    assert np.all(noisy[:, 200:300] > 0)  # the slab itself is lit
+    assert np.count_nonzero(noisy == 0) == shadow.size
+
+
+def test_projector_shadow_mask_width():
+    mask = projector_shadows(_step_image(), FX, 0.075)
+    assert np.all(mask[:, 187:200]) and mask.sum() == 13 * mask.shape[0]
+
+
+def test_tof_flying_pixels_only_at_depth_edges():
+    depth = _step_image(near=1.5, far=3.0)
+    noisy = apply_noise(depth, "tof", np.random.default_rng(4), flying_fraction=1.0, dropout=0.0)
+    sigma = depth_std(3.0, "tof")
+    between = (noisy > 1.5 + 5 * sigma) & (noisy < 3.0 - 5 * sigma)
+    cols = np.flatnonzero(between.any(axis=0))
+    assert set(cols) <= {199, 200, 299, 300}
+    assert between[:, [199, 200, 299, 300]].mean() > 0.8  # all mixed; a few mix very little
+    # Away from the edges only Gaussian noise.
+    far = np.r_[0:198, 302:400]
+    assert np.all(np.abs(noisy[:, far] - depth[:, far]) < 6 * sigma)
+    none = apply_noise(depth, "tof", np.random.default_rng(4), flying_fraction=0.0, dropout=0.0)
+    assert not ((none > 1.5 + 5 * sigma) & (none < 3.0 - 5 * sigma)).any()
+
+
+def test_out_of_range_and_dropouts_become_invalid():
+    rng = np.random.default_rng(5)
+    assert not apply_noise(np.full((20, 20), 4.8), "tof", rng).any()  # beyond 4.5 m
+    assert not apply_noise(np.full((20, 20), 0.3), "structured_light", rng, fx=FX).any()  # too near
+    wall = np.full((300, 300), 2.0)
+    lost = apply_noise(wall, "tof", rng, dropout=0.1) == 0
+    assert lost.mean() == pytest.approx(0.1, abs=0.01)
+
+
+@pytest.mark.parametrize("model", sorted(NOISE_MODELS))
+def test_invalid_pixels_stay_invalid(model):
+    rng = np.random.default_rng(6)
+    depth = rng.uniform(1.0, 3.0, size=(80, 90))
+    holes = rng.random(depth.shape) < 0.2
+    depth[holes] = 0.0
+    noisy = apply_noise(depth, model, rng, fx=FX)
+    assert noisy.dtype == np.float32 and noisy.shape == depth.shape
+    assert np.all(noisy[holes] == 0) and np.all(np.isfinite(noisy)) and np.all(noisy >= 0)
+
+
+@pytest.mark.parametrize("model", sorted(NOISE_MODELS))
+def test_same_seed_same_output(model):
+    depth = _step_image()
+    a = apply_noise(depth, model, np.random.default_rng(7), fx=FX)
+    b = apply_noise(depth, model, np.random.default_rng(7), fx=FX)
+    np.testing.assert_array_equal(a, b)
+    c = apply_noise(depth, model, np.random.default_rng(8), fx=FX)
+    if model == "none":
+        np.testing.assert_array_equal(a, depth)
+    else:
+        assert not np.array_equal(a, c)
+
+
+def test_bad_input_is_rejected():
+    rng = np.random.default_rng(0)
+    wall = np.full((10, 10), 2.0)
+    with pytest.raises(ValueError, match="structured_light"):
+        apply_noise(wall, "kinect", rng)
+    with pytest.raises(ValueError, match="flying_fraction"):
+        apply_noise(wall, "structured_light", rng, fx=FX, flying_fraction=0.2)
+    with pytest.raises(ValueError, match="fx"):
+        apply_noise(wall, "structured_light", rng)
+    with pytest.raises(ValueError, match="Generator"):
+        apply_noise(wall, "tof", 42)
+    with pytest.raises(ValueError, match="2-D"):
+        apply_noise(np.ones(5), "tof", rng)
+    with pytest.raises(ValueError, match="finite"):
+        apply_noise(np.full((3, 3), np.nan), "none", rng)
+    with pytest.raises(ValueError, match="dropout"):
+        apply_noise(wall, "tof", rng, dropout=1.5)
