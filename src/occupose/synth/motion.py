@@ -166,8 +166,6 @@ POSE_NAMES: tuple[str, ...] = (
 POSE_INDEX: dict[str, int] = {name: i for i, name in enumerate(POSE_NAMES)}
 POSE_SIZE = len(POSE_NAMES)
 
-_LEG = slice(HIP_FLEX, KNEE + 1)
-_ARM = slice(SHOULDER_FLEX, ELBOW + 1)
 _UPPER = np.r_[TRUNK_LEAN:NECK_FLEX + 1, LEFT + SHOULDER_FLEX:LEFT + ELBOW + 1,
                RIGHT + SHOULDER_FLEX:RIGHT + ELBOW + 1]
 _SIDES = ((LEFT, 1.0), (RIGHT, -1.0))
@@ -180,7 +178,7 @@ STAND_KNEE = 0.06
 
 def pose_with(pose, **values) -> np.ndarray:
     """A copy of ``pose`` (D,) with the named entries (see :data:`POSE_NAMES`) replaced."""
-    out = _check_pose(pose)
+    out = _check_pose(pose, "pose")
     for name, value in values.items():
         if name not in POSE_INDEX:
             raise ValueError(f"unknown pose entry {name!r}; valid names: {', '.join(POSE_NAMES)}")
@@ -236,14 +234,18 @@ def _rotations(axis: int, angles) -> np.ndarray:
 
 
 def _limb(root, fwd, out, up, side, flex, abd, rot, bend, l1, l2, leg: bool):
-    """Middle and end joints (N, 3) of a two-segment limb (see the module docstring)."""
+    """Middle and end joints (N, 3) of a two-segment limb (see the module docstring).
+
+    ``fwd``, ``out`` (away from the body's midline) and ``up`` (N, 3) are the frame the limb
+    hangs in; at zero angles it points down and bends forward (arm) or backward (leg).
+    """
     cf, sf = np.cos(flex)[:, None], np.sin(flex)[:, None]
     ca, sa = np.cos(abd)[:, None], np.sin(abd)[:, None]
-    a = ca * (sf * fwd - cf * up) + sa * out
-    p = cf * fwd + sf * up
+    a = ca * (sf * fwd - cf * up) + sa * out  # upper segment: flexed forward, then swung out
+    p = cf * fwd + sf * up  # bending direction, perpendicular to a and to out
     if leg:
         p = -p
-    q = side * np.cross(p, a)
+    q = side * np.cross(p, a)  # p turned a quarter outwards about a (external rotation)
     p = np.cos(rot)[:, None] * p + np.sin(rot)[:, None] * q
     d = np.cos(bend)[:, None] * a + np.sin(bend)[:, None] * p
     mid = root + l1 * a
