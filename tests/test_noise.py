@@ -4,12 +4,83 @@ import numpy as np
 import pytest
 
 from occupose.synth.noise import (
-    KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, NOISE_MODELS, apply_noise,
-    depth_std, projector_shadows,
+    KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, NOISE_MODELS, apply_noise, depth_std,
 )
 
 FX = 525.0
 
+
+# --- slow NumPy references of the kernels (same draws from an identically seeded rng) -----
+
+def _reference_shadows(z, fx_baseline):
+    """Pixels whose projector coordinate u - fx_baseline / z breaks the row order."""
+    if fx_baseline < 0:
+        return _reference_shadows(z[:, ::-1], -fx_baseline)[:, ::-1]
+    valid = z > 0
+    projector_u = np.where(valid, np.arange(z.shape[1]) - fx_baseline / np.where(valid, z, 1.0), np.inf)
+    right_min = np.full_like(projector_u, np.inf)  # smallest coordinate strictly to the right
+    right_min[:, :-1] = np.minimum.accumulate(projector_u[:, :0:-1], axis=1)[:, ::-1]
+    return valid & (projector_u > right_min)
+
+
+def _reference_structured_light(z, rng, fx_baseline, min_range, max_range):
+    measured = (z > 0) & ~_reference_shadows(z, fx_baseline) & (z >= min_range) & (z <= max_range)
+    zm = z[measured]
+    noise = rng.standard_normal(len(zm))
+    step, offset = KINECT_V1_INVERSE_DEPTH_STEP, KINECT_V1_INVERSE_DEPTH_OFFSET
+    std_raw = depth_std(zm, "structured_light") / (step * zm**2)
+    raw = np.floor((offset - 1.0 / zm) / step + np.sqrt(np.maximum(std_raw**2 - 1 / 12, 0)) * noise + 0.5)
+    out = np.zeros(z.shape, np.float32)
+    out[measured] = 1.0 / (offset - step * raw)
+    return out
+
+
+def _reference_tof(z, rng, flying_fraction, edge_jump, min_range, max_range):
+    padded = np.pad(z, 1)
+    jump, other = np.zeros_like(z), z.copy()
+    for neighbour in (padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2], padded[1:-1, 2:]):
+        larger = (neighbour > 0) & (np.abs(neighbour - z) > jump)
+        jump, other = np.where(larger, np.abs(neighbour - z), jump), np.where(larger, neighbour, other)
+    edge = (z > 0) & (jump > edge_jump)
+    draws = rng.random((np.count_nonzero(edge), 2))
+    flies = np.flatnonzero(edge)[draws[:, 0] < flying_fraction]  # row-major order, as drawn
+    share = draws[draws[:, 0] < flying_fraction, 1]
+    mixed = z.copy().reshape(-1)
+    mixed[flies] += share * (other.reshape(-1)[flies] - mixed[flies])
+    mixed = mixed.reshape(z.shape)
+    measured = (z > 0) & (z >= min_range) & (z <= max_range)
+    m = mixed[measured]
+    value = m + depth_std(m, "tof") * rng.standard_normal(len(m))
+    out = np.zeros(z.shape, np.float32)
+    out[measured] = np.where(value > 0, value, 0.0)
+    return out
+
+
+def _random_depth(rng, shape=(40, 60)):
+    """Piecewise-flat depth with steps, holes and out-of-range pixels."""
+    depth = np.repeat(np.repeat(rng.uniform(0.3, 5.5, size=(shape[0] // 4, shape[1] // 6)), 4, 0), 6, 1)
+    depth += rng.normal(scale=0.01, size=shape)
+    depth[rng.random(shape) < 0.05] = 0.0
+    return depth
+
+
+@pytest.mark.parametrize("baseline", [0.075, -0.05])
+def test_structured_light_kernel_matches_reference(baseline):
+    depth = _random_depth(np.random.default_rng(20))
+    got = apply_noise(depth, "structured_light", np.random.default_rng(21), fx=FX, baseline=baseline, dropout=0.0)
+    expected = _reference_structured_light(depth, np.random.default_rng(21), FX * baseline, 0.5, 5.0)
+    np.testing.assert_array_equal(got, expected)
+    assert 0 < np.count_nonzero(_reference_shadows(depth, FX * baseline))
+
+
+def test_tof_kernel_matches_reference():
+    depth = _random_depth(np.random.default_rng(22))
+    got = apply_noise(depth, "tof", np.random.default_rng(23), flying_fraction=0.6, edge_jump=0.05, dropout=0.0)
+    expected = _reference_tof(depth, np.random.default_rng(23), 0.6, 0.05, 0.5, 4.5)
+    np.testing.assert_array_equal(got, expected)
+
+
+# --- behaviour ---------------------------------------------------------------------------
 
 def _step_image(near=1.5, far=3.0, cols=(200, 300), shape=(60, 400)):
     """A wall at ``far`` with a foreground slab at ``near`` over columns [cols[0], cols[1])."""
@@ -67,11 +138,6 @@ def test_projector_shadows_fall_beside_the_foreground(baseline):
     assert np.all(lit > 0) and np.all(outside > 0)
     assert np.all(noisy[:, 200:300] > 0)  # the slab itself is lit
     assert np.count_nonzero(noisy == 0) == shadow.size
-
-
-def test_projector_shadow_mask_width():
-    mask = projector_shadows(_step_image(), FX, 0.075)
-    assert np.all(mask[:, 187:200]) and mask.sum() == 13 * mask.shape[0]
 
 
 def test_tof_flying_pixels_only_at_depth_edges():

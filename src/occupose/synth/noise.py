@@ -22,32 +22,24 @@ from typing import Callable
 
 import numpy as np
 
+from occupose.synth import _kernels
+
 #: Kinect v1 raw disparity to depth: 1 / z = OFFSET - STEP * raw (z in metres). The
 #: widely used fit of the OpenKinect / ROS drivers; one raw unit is about 1/8 pixel.
 KINECT_V1_INVERSE_DEPTH_OFFSET = 3.3309495161
 KINECT_V1_INVERSE_DEPTH_STEP = 0.0030711016
 
 
-def _std_structured_light(z):
-    """Nguyen, Izadi & Lovell (2012), Kinect v1 axial noise at moderate surface angles."""
-    return 0.0012 + 0.0019 * (z - 0.4) ** 2
-
-
-def _std_tof(z):
-    """Fankhauser et al. (2015), Kinect v2 axial noise at normal incidence (mm -> m).
-
-    Below 5.3 mm over 0.5-4.5 m, within the Azure Kinect's specified random error
-    (standard deviation <= 17 mm over its 0.5-3.86 m range).
-    """
-    return 1e-3 * (1.5 - 0.5 * z + 0.3 * z**2)
-
-
-def _std_none(z):
-    return np.zeros_like(z)
-
-
-_DEPTH_STD: dict[str, Callable] = {
-    "none": _std_none, "structured_light": _std_structured_light, "tof": _std_tof,
+#: Random depth error of each model as a quadratic c0 + c1 z + c2 z^2 (metres, z in metres).
+_STD_COEFFS: dict[str, np.ndarray] = {
+    "none": np.zeros(3),
+    # Nguyen, Izadi & Lovell (2012), Kinect v1 axial noise at moderate surface angles:
+    # 0.0012 + 0.0019 (z - 0.4)^2, expanded.
+    "structured_light": np.array([0.0012 + 0.0019 * 0.16, -0.0019 * 0.8, 0.0019]),
+    # Fankhauser et al. (2015), Kinect v2 axial noise at normal incidence:
+    # 1.5 - 0.5 z + 0.3 z^2 mm. Below 5.3 mm over 0.5-4.5 m, within the Azure Kinect's
+    # specified random error (standard deviation <= 17 mm over its 0.5-3.86 m range).
+    "tof": np.array([1.5e-3, -0.5e-3, 0.3e-3]),
 }
 
 
@@ -55,13 +47,16 @@ def depth_std(z, model: str):
     """Random depth error (one standard deviation, metres) of ``model`` at depth ``z``.
 
     z : float or (...) array, metres. Returns a float for a scalar ``z``, else an array
-    of the same shape (float64). For ``"structured_light"`` it includes the disparity
-    quantisation; the systematic (bias) errors of real sensors are not modelled.
+    of the same shape (float64). ``"structured_light"``: 0.0012 + 0.0019 (z - 0.4)^2
+    (Nguyen et al. 2012), including the disparity quantisation; ``"tof"``: (1.5 - 0.5 z +
+    0.3 z^2) mm (Fankhauser et al. 2015); ``"none"``: 0. Systematic (bias) errors of real
+    sensors are not modelled.
     """
-    if model not in _DEPTH_STD:
-        raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(_DEPTH_STD)}")
+    if model not in _STD_COEFFS:
+        raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(_STD_COEFFS)}")
+    c0, c1, c2 = _STD_COEFFS[model]
     values = np.asarray(z, dtype=np.float64)
-    std = _DEPTH_STD[model](values)
+    std = c0 + c1 * values + c2 * values**2
     return float(std) if std.ndim == 0 else std
 
 
@@ -69,7 +64,7 @@ def _check_depth(depth) -> np.ndarray:
     array = np.asarray(depth)
     if array.ndim != 2 or array.dtype.kind not in "fiu":
         raise ValueError(f"depth must be a 2-D array of metres, got shape {array.shape} dtype {array.dtype}")
-    array = array.astype(np.float64)
+    array = np.ascontiguousarray(array, dtype=np.float64)
     if not np.all(np.isfinite(array)) or np.any(array < 0.0):
         raise ValueError("depth must be finite and >= 0 (0 = no measurement)")
     return array
@@ -81,43 +76,21 @@ def _check_rate(value: float, what: str) -> float:
     return float(value)
 
 
-def _in_range(z: np.ndarray, min_range: float, max_range: float) -> np.ndarray:
+def _check_range(min_range: float, max_range: float) -> None:
     if not 0.0 <= min_range < max_range:
         raise ValueError(f"need 0 <= min_range < max_range, got {min_range!r}, {max_range!r}")
-    return (z >= min_range) & (z <= max_range)
+
+
+def _drop(depth: np.ndarray, rng: np.random.Generator, rate: float) -> np.ndarray:
+    """Zero each pixel with probability ``rate`` (in place; returns ``depth``)."""
+    count = rng.binomial(depth.size, rate)
+    depth.reshape(-1)[rng.choice(depth.size, size=count, replace=False)] = 0.0
+    return depth
 
 
 def no_noise(depth, rng: np.random.Generator) -> np.ndarray:
     """The ideal sensor: a float32 copy of ``depth`` (H, W), metres."""
     return _check_depth(depth).astype(np.float32)
-
-
-def projector_shadows(depth, fx: float, baseline: float = 0.075) -> np.ndarray:
-    """Pixels that a structured-light projector beside the camera cannot light.
-
-    depth : (H, W) float, metres, 0 = no surface
-    fx : float, focal length in pixels
-    baseline : float, metres, the projector's offset along the camera's x axis (positive:
-        to the image's right, as on a Kinect v1, which puts the shadows on the left of
-        foreground objects; negative: the other side)
-
-    Returns a (H, W) bool mask. A surface point is lit when no nearer surface point of the
-    same image row lies on its projector ray, i.e. while its projector coordinate
-    ``u - fx * baseline / z`` keeps the camera's left-to-right order. The band is about
-    ``fx * |baseline| * (1 / z_near - 1 / z_far)`` pixels wide beside each depth edge.
-    """
-    z = _check_depth(depth)
-    if fx is None or not fx > 0:
-        raise ValueError(f"fx must be a positive focal length in pixels, got {fx!r}")
-    if baseline < 0:
-        return projector_shadows(z[:, ::-1], fx, -baseline)[:, ::-1]
-    valid = z > 0
-    with np.errstate(divide="ignore"):
-        projector_u = np.where(valid, np.arange(z.shape[1]) - fx * baseline / np.where(valid, z, 1.0), np.inf)
-    # Smallest projector coordinate strictly to the right of each pixel.
-    right_min = np.full_like(projector_u, np.inf)
-    right_min[:, :-1] = np.minimum.accumulate(projector_u[:, :0:-1], axis=1)[:, ::-1]
-    return valid & (projector_u > right_min)
 
 
 def structured_light_noise(depth, rng: np.random.Generator, *, fx: float | None = None,
@@ -128,36 +101,34 @@ def structured_light_noise(depth, rng: np.random.Generator, *, fx: float | None 
     depth : (H, W) float, metres, 0 = no measurement
     rng : np.random.Generator
     fx : float, pixels; required when ``shadows`` is on
-    baseline : float, metres, projector offset along the camera x axis (see :func:`projector_shadows`)
-    shadows : bool, blank the projector's shadows
+    baseline : float, metres, the projector's offset along the camera's x axis (positive:
+        to the image's right, as on a Kinect v1, which puts the shadows on the left of
+        foreground objects; negative: the other side)
+    shadows : bool, blank the pixels the projector cannot light
     dropout : float in [0, 1], share of pixels randomly lost
     min_range, max_range : float, metres; true depths outside are not measured
         (Kinect v1 returns depth from about 0.5 to 5 m; its nominal range is 0.8-4 m)
 
-    Depth becomes the raw disparity ``(OFFSET - 1/z) / STEP`` (one unit is about 1/8 pixel),
-    gets Gaussian noise, is rounded to a whole unit and turned back into depth, so depth is
-    quantised in steps of ``STEP * z^2`` (about 0.00307 z^2 m). The Gaussian part is chosen
-    so that noise and rounding together have the standard deviation ``depth_std(z,
-    "structured_light")``. Returns (H, W) float32.
+    Shadows: a surface point is lit when no nearer point of the same image row lies on its
+    projector ray, i.e. while its projector coordinate ``u - fx * baseline / z`` keeps the
+    camera's order; the band beside a depth edge is about ``fx * |baseline| * (1 / z_near -
+    1 / z_far)`` pixels wide. Noise: depth becomes the raw disparity ``(OFFSET - 1/z) /
+    STEP`` (one unit is about 1/8 pixel), gets Gaussian noise, is rounded to a whole unit
+    and turned back into depth, so depth is quantised in steps of ``STEP * z^2`` (about
+    0.00307 z^2 m); the Gaussian part is chosen so that noise and rounding together have
+    the standard deviation ``depth_std(z, "structured_light")``. Returns (H, W) float32.
     """
     z = _check_depth(depth)
     dropout = _check_rate(dropout, "dropout")
-    valid = (z > 0) & _in_range(z, min_range, max_range)
-    if shadows:
-        if fx is None:
-            raise ValueError("structured_light noise needs fx (pixels) to place the projector shadows")
-        valid &= ~projector_shadows(z, fx, baseline)
-    noise = rng.standard_normal(z.shape)
-    lost = rng.random(z.shape) < dropout
-
-    zv = np.where(valid, z, 1.0)
-    step, offset = KINECT_V1_INVERSE_DEPTH_STEP, KINECT_V1_INVERSE_DEPTH_OFFSET
-    raw = (offset - 1.0 / zv) / step
-    total = _std_structured_light(zv) / (step * zv**2)  # wanted std in raw units (dz = step z^2 draw)
-    gaussian = np.sqrt(np.maximum(total**2 - 1.0 / 12.0, 0.0))  # rounding adds 1/12 unit^2
-    inverse = offset - step * np.round(raw + gaussian * noise)
-    valid &= ~lost & (inverse > 0.0)
-    return np.where(valid, 1.0 / np.where(valid, inverse, 1.0), 0.0).astype(np.float32)
+    _check_range(min_range, max_range)
+    if shadows and (fx is None or not fx > 0):
+        raise ValueError(f"structured_light noise needs fx > 0 (pixels) to place the projector shadows, got {fx!r}")
+    out = np.empty(z.shape, np.float32)
+    _kernels.structured_light_pixels(
+        z, rng, float(fx or 0.0) * float(baseline), bool(shadows), float(min_range), float(max_range),
+        _STD_COEFFS["structured_light"], KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, out,
+    )
+    return _drop(out, rng, dropout)
 
 
 def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, edge_jump: float = 0.05,
@@ -180,28 +151,13 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
     z = _check_depth(depth)
     flying_fraction = _check_rate(flying_fraction, "flying_fraction")
     dropout = _check_rate(dropout, "dropout")
+    _check_range(min_range, max_range)
     if not edge_jump > 0:
         raise ValueError(f"edge_jump must be > 0 metres, got {edge_jump!r}")
-    valid = (z > 0) & _in_range(z, min_range, max_range)
-    noise = rng.standard_normal(z.shape)
-    mix = rng.random(z.shape)
-    flies = rng.random(z.shape) < flying_fraction
-    lost = rng.random(z.shape) < dropout
-
-    # The measured 4-neighbour that differs most from each pixel.
-    padded = np.pad(z, 1)
-    other = np.zeros_like(z)
-    jump = np.zeros_like(z)
-    for neighbour in (padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2], padded[1:-1, 2:]):
-        larger = (neighbour > 0) & (np.abs(neighbour - z) > jump)
-        other = np.where(larger, neighbour, other)
-        jump = np.where(larger, np.abs(neighbour - z), jump)
-    edge = (z > 0) & (jump > edge_jump)
-    mixed = np.where(edge & flies, z + mix * (other - z), z)
-
-    noisy = mixed + _std_tof(mixed) * noise
-    valid &= ~lost & (noisy > 0)
-    return np.where(valid, noisy, 0.0).astype(np.float32)
+    out = np.empty(z.shape, np.float32)
+    _kernels.tof_pixels(z, rng, flying_fraction, float(edge_jump), float(min_range), float(max_range),
+                        _STD_COEFFS["tof"], out)
+    return _drop(out, rng, dropout)
 
 
 #: Noise models by name: each is ``f(depth, rng, **options) -> depth``.
