@@ -3,9 +3,12 @@
 import numpy as np
 import pytest
 
+from occupose.synth import primitives as prim
+
 from occupose.synth.noise import (
     KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, NOISE_MODELS, apply_noise, depth_std,
 )
+from occupose.synth.render import render
 
 FX = 525.0
 
@@ -122,6 +125,23 @@ def test_structured_light_is_quantised_in_raw_disparity_units():
     assert np.diff(levels).min() == pytest.approx(0.00307 * 4, rel=0.05)
 
 
+def test_rendered_ball_casts_its_shadow_on_its_left():
+    scene = prim.concat([
+        prim.box((0.0, 0.0, 3.1), (3.0, 3.0, 0.1), (200, 200, 200)),   # wall at z = 3
+        prim.ellipsoid((0.0, 0.0, 1.5), (0.2, 0.2, 0.2), (200, 0, 0), person=1),
+    ])
+    fx = 140.0
+    ideal = render(scene, 160, 120, fx, fx, 79.5, 59.5, np.eye(4))
+    noisy = apply_noise(ideal.depth, "structured_light", np.random.default_rng(9), fx=fx, dropout=0.0)
+    shadow = (noisy == 0) & (ideal.depth > 0)
+    assert shadow.sum() > 20
+    band = fx * 0.075 * (1 / 1.3 - 1 / 3.0) + 1  # widest where the ball is nearest
+    for v in np.flatnonzero(shadow.any(axis=1)):
+        ball = np.flatnonzero(ideal.person[v])
+        cols = np.flatnonzero(shadow[v])
+        assert len(ball) and cols.max() < ball.min() and cols.min() > ball.min() - band
+
+
 @pytest.mark.parametrize("baseline", [0.075, -0.075])
 def test_projector_shadows_fall_beside_the_foreground(baseline):
     depth = _step_image()
@@ -199,6 +219,8 @@ def test_bad_input_is_rejected():
         apply_noise(wall, "structured_light", rng)
     with pytest.raises(ValueError, match="Generator"):
         apply_noise(wall, "tof", 42)
+    with pytest.raises(ValueError, match="Generator"):
+        apply_noise(wall, "none", None)
     with pytest.raises(ValueError, match="2-D"):
         apply_noise(np.ones(5), "tof", rng)
     with pytest.raises(ValueError, match="finite"):

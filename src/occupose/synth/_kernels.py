@@ -1,6 +1,7 @@
-"""Numba kernels of the synthetic renderer (private: use :mod:`occupose.synth.render`).
+"""Numba kernels of the synthetic renderer and the sensor noise models (private: use
+:mod:`occupose.synth.render` and :mod:`occupose.synth.noise`).
 
-Everything here works in the camera frame (OpenCV axes, the camera centre at the origin).
+The renderer's kernels work in the camera frame (OpenCV axes, the camera centre at the origin).
 The ray through pixel ``(u, v)`` is ``t * (xs[u], ys[v], 1)``, so the ray parameter ``t``
 of a hit *is* its depth (camera z).
 

@@ -70,6 +70,11 @@ def _check_depth(depth) -> np.ndarray:
     return array
 
 
+def _check_rng(rng) -> None:
+    if not isinstance(rng, np.random.Generator):
+        raise ValueError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
+
+
 def _check_rate(value: float, what: str) -> float:
     if not 0.0 <= value <= 1.0:
         raise ValueError(f"{what} must be in [0, 1], got {value!r}")
@@ -89,7 +94,8 @@ def _drop(depth: np.ndarray, rng: np.random.Generator, rate: float) -> np.ndarra
 
 
 def no_noise(depth, rng: np.random.Generator) -> np.ndarray:
-    """The ideal sensor: a float32 copy of ``depth`` (H, W), metres."""
+    """The ideal sensor: a float32 copy of ``depth`` (H, W), metres (``rng`` is not used)."""
+    _check_rng(rng)
     return _check_depth(depth).astype(np.float32)
 
 
@@ -119,6 +125,7 @@ def structured_light_noise(depth, rng: np.random.Generator, *, fx: float | None 
     the standard deviation ``depth_std(z, "structured_light")``. Returns (H, W) float32.
     """
     z = _check_depth(depth)
+    _check_rng(rng)
     dropout = _check_rate(dropout, "dropout")
     _check_range(min_range, max_range)
     if shadows and (fx is None or not fx > 0):
@@ -149,6 +156,7 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
     measured pixel then gets Gaussian noise of ``depth_std(z, "tof")``. Returns (H, W) float32.
     """
     z = _check_depth(depth)
+    _check_rng(rng)
     flying_fraction = _check_rate(flying_fraction, "flying_fraction")
     dropout = _check_rate(dropout, "dropout")
     _check_range(min_range, max_range)
@@ -180,8 +188,6 @@ def apply_noise(depth, model: str, rng: np.random.Generator, *, fx: float | None
     """
     if model not in NOISE_MODELS:
         raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(NOISE_MODELS)}")
-    if not isinstance(rng, np.random.Generator):
-        raise ValueError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
     function = NOISE_MODELS[model]
     accepted = [name for name, p in inspect.signature(function).parameters.items()
                 if p.kind is inspect.Parameter.KEYWORD_ONLY]
