@@ -176,6 +176,10 @@ def test_camera_inside_a_box_sees_its_walls():
     assert np.all(got.depth > 0)
     # The wall at x = 3 fills the centre of the view at camera z = 3.
     np.testing.assert_allclose(got.depth[14:34, 12:52], 3.0, atol=1e-5)
+    dome = prim.ellipsoid((0.0, 0.0, 1.5), (5.0, 5.0, 5.0), (200, 200, 200))
+    inside = _render(dome, pose)
+    length = np.sqrt(1 + ((np.arange(W) - CX) / F) ** 2 + ((np.arange(H)[:, None] - CY) / F) ** 2)
+    np.testing.assert_allclose(inside.depth, 5.0 / length, rtol=1e-6)  # ray length 5 everywhere
 
 
 # --- against the sphere-tracing reference ------------------------------------------------
