@@ -3,7 +3,9 @@
 Scene: a 6 x 6 m room (floor and four walls) with furniture, 12 boxes in all, seen by a
 camera in a corner 2.5 m up; people of 16 primitives each (ellipsoids, round cones,
 boxes). Cases: the full render of everything, and the per-frame render of the people
-over a pre-rendered static background; then each noise model on the rendered depth.
+over a pre-rendered static background, each on one thread and on all numba threads (a
+busy machine slows the threaded runs most); then each noise model (single-threaded) on
+the rendered depth.
 
 Run: ``python benchmarks/bench_render.py`` (prints a table); ``run()`` returns the rows.
 """
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 import time
 
+import numba
 import numpy as np
 
 from occupose.camera import look_at
@@ -92,30 +95,40 @@ def _median_ms(function, repeats: int, warmup: int = 3) -> tuple[float, float]:
 
 
 def run(repeats: int = 30) -> list[dict]:
-    """Time the cases; one dict per case with keys case, people, primitives, ms_median, ms_min."""
+    """Time the cases, on one thread and on all numba threads.
+
+    Returns one dict per case: case, people, primitives, threads, ms_median, ms_min.
+    """
     pose = look_at((-2.7, -2.7, 2.5), (0.5, 0.5, 0.8))
     view = (WIDTH, HEIGHT, FX, FY, CX, CY, pose)
     static = static_scene()
     background = render(static, *view)
     rows = []
-    for count in (1, 3):
-        moving = people(count)
-        everything = prim.concat([static, moving])
-        for case, function, k in (
-            ("full render", lambda: render(everything, *view), len(everything)),
-            ("background + people", lambda: render(moving, *view, background=background), len(moving)),
-        ):
-            median, best = _median_ms(function, repeats)
-            rows.append({"case": case, "people": count, "primitives": k, "ms_median": median, "ms_min": best})
+    all_threads = numba.config.NUMBA_NUM_THREADS
+    for threads in sorted({1, all_threads}):
+        numba.set_num_threads(threads)
+        for count in (1, 3):
+            moving = people(count)
+            everything = prim.concat([static, moving])
+            for case, function, k in (
+                ("full render", lambda: render(everything, *view), len(everything)),
+                ("background + people", lambda: render(moving, *view, background=background), len(moving)),
+            ):
+                median, best = _median_ms(function, repeats)
+                rows.append({"case": case, "people": count, "primitives": k, "threads": threads,
+                             "ms_median": median, "ms_min": best})
+    numba.set_num_threads(all_threads)
     depth = render(prim.concat([static, people(1)]), *view).depth
     for model in ("structured_light", "tof"):
         rng = np.random.default_rng(0)
         median, best = _median_ms(lambda: apply_noise(depth, model, rng, fx=FX), repeats)
-        rows.append({"case": f"noise {model}", "people": 1, "primitives": 0, "ms_median": median, "ms_min": best})
+        rows.append({"case": f"noise {model}", "people": 1, "primitives": 0, "threads": 1,
+                     "ms_median": median, "ms_min": best})
     return rows
 
 
 if __name__ == "__main__":
-    print(f"{'case':<24}{'people':>7}{'prims':>7}{'ms median':>11}{'ms min':>9}   (640x480)")
+    print(f"{'case':<24}{'people':>7}{'prims':>7}{'threads':>8}{'ms median':>11}{'ms min':>9}   (640x480)")
     for row in run():
-        print(f"{row['case']:<24}{row['people']:>7}{row['primitives']:>7}{row['ms_median']:>11.2f}{row['ms_min']:>9.2f}")
+        print(f"{row['case']:<24}{row['people']:>7}{row['primitives']:>7}{row['threads']:>8}"
+              f"{row['ms_median']:>11.2f}{row['ms_min']:>9.2f}")
