@@ -211,8 +211,8 @@ def test_rotated_box_and_ellipsoid_match_reference():
     rng = np.random.default_rng(3)
     pose = look_at((-1.0, -3.0, 2.0), (0.0, 0.0, 1.0))
     shapes = prim.concat([
-        prim.box((0.4, 0.2, 1.0), (0.5, 0.3, 0.2), (200, 150, 100), axes=_random_rotation(rng), person=2, part=7),
-        prim.ellipsoid((-0.5, 0.0, 1.2), (0.4, 0.2, 0.3), (100, 200, 150), axes=_random_rotation(rng), person=3, part=9),
+        prim.box((0.4, 0.2, 1.0), (0.5, 0.3, 0.2), (200, 150, 100), _random_rotation(rng), person=2, part=7),
+        prim.ellipsoid((-0.5, 0.0, 1.2), (0.4, 0.2, 0.3), (100, 200, 150), _random_rotation(rng), person=3, part=9),
     ])
     _assert_matches_reference(shapes, pose)
 
