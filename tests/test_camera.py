@@ -231,7 +231,7 @@ def test_presets_carry_the_documented_sensor_values():
         "kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.8, 4.0, "structured_light")
     assert CAMERA_PRESETS["kinect_v2"] == SensorSpec("kinect_v2", 512, 424, 365.5, 365.5, 254.9, 205.4, 0.5, 4.5, "tof")
     assert CAMERA_PRESETS["realsense_d435"] == SensorSpec(
-        "realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "stereo")
+        "realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "structured_light")
     azure = sensor_spec("azure_nfov")
     assert (azure.width, azure.height, azure.cx, azure.cy, azure.noise) == (640, 576, 332.78, 304.83, "tof")
     assert (azure.near, azure.far) == (0.5, 3.86)

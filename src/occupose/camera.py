@@ -349,7 +349,8 @@ class SensorSpec:
 
     width, height : int, pixels; fx, fy, cx, cy : float, pixels;
     near, far : float, metres, nominal measuring range;
-    noise : str, noise family of the sensor ("structured_light", "tof" or "stereo").
+    noise : str, name of the sensor noise model in occupose.synth.noise ("structured_light" for
+        Kinect v1 and, for want of a stereo model, the active-stereo RealSense; "tof").
     """
 
     name: str
@@ -375,7 +376,7 @@ CAMERA_PRESETS: dict[str, SensorSpec] = {
         SensorSpec("kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.8, 4.0, "structured_light"),
         SensorSpec("kinect_v2", 512, 424, 365.5, 365.5, 254.9, 205.4, 0.5, 4.5, "tof"),
         SensorSpec("azure_nfov", 640, 576, 504.61, 504.73, 332.78, 304.83, 0.5, 3.86, "tof"),
-        SensorSpec("realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "stereo"),
+        SensorSpec("realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "structured_light"),
     )
 }
 

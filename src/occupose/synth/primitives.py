@@ -78,3 +78,9 @@ def concat(batches: list[Primitives]) -> Primitives:
         )
     return Primitives(*(np.ascontiguousarray(np.concatenate([getattr(b, f) for b in batches]))
                         for f in ("kind", "center", "axes", "size", "end", "person", "part", "color")))
+
+
+def select(prims: Primitives, mask) -> Primitives:
+    """The primitives where ``mask`` (K,) bool (or an index array) selects them."""
+    return Primitives(*(np.ascontiguousarray(getattr(prims, f)[mask])
+                        for f in ("kind", "center", "axes", "size", "end", "person", "part", "color")))

@@ -1,0 +1,87 @@
+"""Pictures of recordings: a colour-mapped depth image with skeletons drawn over it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from occupose.camera import pixels_from_points
+from occupose.joints import BONES
+from occupose.recording import Recording
+
+
+def _figure(width: int, height: int, panels: int):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scale = 6.0 / width
+    fig, axes = plt.subplots(1, panels, figsize=(panels * width * scale, height * scale + 0.5),
+                             squeeze=False)
+    return fig, axes[0]
+
+
+def draw_skeleton(ax, uv: np.ndarray, visible: np.ndarray, color: str, label: str | None = None) -> None:
+    """Draw one skeleton on an image axis.
+
+    uv : (15, 2) pixel coordinates (NaN for joints not drawn); visible : (15,) bool.
+    Visible joints are filled dots with solid bones; hidden joints crosses with dashed bones.
+    """
+    for a, b in BONES:
+        if np.all(np.isfinite(uv[[a, b]])):
+            style = "-" if visible[a] and visible[b] else "--"
+            ax.plot(uv[[a, b], 0], uv[[a, b], 1], style, color=color, lw=1.6, alpha=0.9)
+    ok = np.all(np.isfinite(uv), axis=1)
+    ax.scatter(uv[ok & visible, 0], uv[ok & visible, 1], s=18, c=color, edgecolors="k", linewidths=0.5,
+               zorder=3, label=label)
+    ax.scatter(uv[ok & ~visible, 0], uv[ok & ~visible, 1], s=26, c=color, marker="x", linewidths=1.6, zorder=3)
+
+
+def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict | None = None) -> Path:
+    """Write a PNG of frame ``index``: for every camera, the depth image colour-mapped
+    (black = no measurement) with the ground-truth skeletons over it (hidden joints as
+    crosses, bones to them dashed) and, when given, tracked skeletons.
+
+    tracks : optional {track id: (joints (T, 15, 3), visible (T, 15))} as read from a tracks.csv.
+    """
+    if not 0 <= index < recording.num_frames:
+        raise ValueError(f"frame {index} is out of range: {recording.path} has frames 0..{recording.num_frames - 1}")
+    frame = recording.frame(index)
+    gt = recording.groundtruth() if recording.has_groundtruth else None
+    cams = recording.cameras
+    fig, axes = _figure(cams[0].width, cams[0].height, len(cams))
+    colors = ["#ff2bd6", "#ffffff", "#7dff6a", "#ffd23f"]
+    for ax, cam in zip(axes, cams):
+        depth = np.where(frame.depth[cam.name] > 0, frame.depth[cam.name], np.nan)
+        im = ax.imshow(depth, cmap="turbo", vmin=0.5, vmax=max(4.5, float(np.nanmax(depth)) if np.any(depth > 0) else 4.5))
+        ax.set_facecolor("black")
+        ax.set_title(f"{recording.path.name} — {cam.name} — frame {index}", fontsize=8)
+        ax.set_xlim(0, cam.width)
+        ax.set_ylim(cam.height, 0)
+        ax.axis("off")
+        fig.colorbar(im, ax=ax, fraction=0.035, pad=0.01, label="depth [m]")
+        if gt is not None:
+            for p in range(gt.joints.shape[1]):
+                joints = gt.joints[index, p]
+                if not np.all(np.isfinite(joints)):
+                    continue
+                uv, z = pixels_from_points(joints, cam)
+                uv[z <= 0] = np.nan
+                draw_skeleton(ax, uv, gt.visible[index, p], colors[p % len(colors)],
+                              label=f"truth person {gt.person_ids[p]}")
+        for k, (track, (joints, visible)) in enumerate(sorted((tracks or {}).items())):
+            if index < len(joints) and np.any(np.isfinite(joints[index])):
+                uv, z = pixels_from_points(np.nan_to_num(joints[index], nan=0.0), cam)
+                uv[~np.isfinite(joints[index]).all(axis=1) | (z <= 0)] = np.nan
+                draw_skeleton(ax, uv, visible[index], "#00e5ff" if k == 0 else "#ff9800", label=f"track {track}")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="lower left", fontsize=6, framealpha=0.6)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return out
