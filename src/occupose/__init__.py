@@ -10,4 +10,8 @@ _os.environ.setdefault(
     str(_Path(_os.environ.get("XDG_CACHE_HOME", _Path.home() / ".cache")) / "occupose" / "numba"),
 )
 
+# Parallel numba kernels: idle OpenMP threads sleep instead of spinning, so a busy core
+# (another process, or the tracker's other stage) does not slow every kernel down.
+_os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 __version__ = "0.1.0"

@@ -128,7 +128,7 @@ def score_text(rec, tracks_path: Path) -> str:
 @main.command("demo")
 @click.option("--out", type=click.Path(path_type=Path), default=Path("demo-output"), show_default=True)
 @click.option("--scenario", default="sit_behind_table", show_default=True)
-@click.option("--frames", type=int, default=150, show_default=True)
+@click.option("--frames", type=int, default=300, show_default=True)
 def demo_cmd(out, scenario, frames) -> None:
     """Render a built-in scenario with procedural motion (no shared data needed) and picture it."""
     from occupose.recording import Recording

@@ -12,7 +12,7 @@ otherwise, and always for what the clips lack (sitting, carrying a chair, walks 
 end at an exact spot). ``Scenario.motion_source`` says which was used.
 
 World frame: metres, z up, floor at z = 0. Front-view scenes look from y = 0 towards +y
-into a 6 m wide room whose back wall stands at y = 6.
+into a 6 m wide room whose back wall stands at y = 4.5 (inside a Kinect's range).
 """
 
 from __future__ import annotations
@@ -183,7 +183,7 @@ def _top(sensor: str | None):
 
 
 def _front_room() -> Primitives:
-    return room(width=6.0, depth=6.5, height=2.8, center_xy=(0.0, 2.75), walls=("+x", "-x", "+y"))
+    return room(width=6.0, depth=5.0, height=2.8, center_xy=(0.0, 2.0), walls=("+x", "-x", "+y"))
 
 
 def _shop_room() -> Primitives:
@@ -285,9 +285,9 @@ def _moved_chair(rng, use_mocap, sensor):
     dims = _dims(rng)
     start, pick, drop = (2.3, 3.4), (0.3, 3.4), (-1.2, 2.6)
     b = pm.MotionBuilder(start, math.pi, dims, FPS)
-    b.walk([(pick[0] + 0.55, pick[1])], speed=1.2).stand(0.5)
+    b.walk([(pick[0] + 0.6, pick[1])], speed=1.2).stand(0.5)
     carry_from = b.num_frames
-    b.walk([(drop[0] + 0.55, drop[1])], speed=0.8)
+    b.walk([(drop[0] + 0.6, drop[1])], speed=0.8)
     carry_to = b.num_frames
     b.stand(0.5).turn(0.0).walk([(2.9, 1.9)], speed=1.2).stand(14.0)
     poses = b.poses()
@@ -296,17 +296,18 @@ def _moved_chair(rng, use_mocap, sensor):
     ramp[carry_from:carry_to] = 1.0
     ramp = np.convolve(ramp, np.ones(12) / 12, mode="same")
     for base in (pm.LEFT, pm.RIGHT):
-        for dof, angle in ((pm.SHOULDER_FLEX, 0.7), (pm.SHOULDER_ABD, 0.1), (pm.ELBOW, 0.9)):
+        for dof, angle in ((pm.SHOULDER_FLEX, 0.55), (pm.SHOULDER_ABD, 0.1), (pm.ELBOW, 0.4)):
             poses[:, base + dof] += ramp * (angle - poses[:, base + dof])
     joints = pm.joints_from_pose(poses, dims)
     n = 600
     chair_xy = np.empty((n, 2))
-    chair_heading = np.zeros(n)
+    chair_heading = np.full(n, math.pi)  # its back rest towards the person coming from +x
     chair_xy[:carry_from] = pick
     for t in range(carry_from, min(carry_to, n)):
         fwd = facing(joints[t])
-        chair_xy[t] = joints[t, J["pelvis"], :2] + 0.55 * np.array([math.cos(fwd), math.sin(fwd)])
-        chair_heading[t] = fwd - math.pi
+        # held by its back rest, which is nearest the person
+        chair_xy[t] = joints[t, J["pelvis"], :2] + 0.6 * np.array([math.cos(fwd), math.sin(fwd)])
+        chair_heading[t] = fwd
     chair_xy[carry_to:] = chair_xy[carry_to - 1]
     chair_heading[carry_to:] = chair_heading[carry_to - 1]
     lift = np.zeros(n)

@@ -1,0 +1,40 @@
+"""Run every benchmark, print its table and save them all to benchmarks/results/latest.md."""
+
+from __future__ import annotations
+
+import os
+import platform
+import time
+from pathlib import Path
+
+from benchmarks import bench_render, format_table
+
+BENCHMARKS = [bench_render]
+
+
+def machine() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, {platform.system()}"
+
+
+def main() -> None:
+    sections = [f"# occupose benchmarks\n\nMachine: {machine()}  \nDate: {time.strftime('%Y-%m-%d')}\n"]
+    for module in BENCHMARKS:
+        table = format_table(module.TITLE, module.run())
+        print(table + "\n", flush=True)
+        sections.append(table + "\n")
+    out = Path(__file__).parent / "results" / "latest.md"
+    out.parent.mkdir(exist_ok=True)
+    out.write_text("\n".join(sections))
+    print(f"saved {out}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,85 @@
+"""The command line end to end on a tiny synthetic recording."""
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from occupose.cli import main
+from occupose.metrics import write_tracks_csv
+from occupose.recording import Recording
+from occupose.synth.scenarios import SCENARIOS
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    out = tmp_path_factory.mktemp("cli") / "rec"
+    result = CliRunner().invoke(main, ["synth", "no_occlusion", str(out), "--frames", "40", "--procedural", "--seed", "2"])
+    assert result.exit_code == 0, result.output
+    assert "wrote" in result.output and "40 frames" in result.output
+    return out
+
+
+def test_scenarios_lists_every_scenario_with_a_line():
+    result = CliRunner().invoke(main, ["scenarios"])
+    assert result.exit_code == 0
+    lines = result.output.strip().splitlines()
+    assert [line.split()[0] for line in lines] == list(SCENARIOS)
+
+
+def test_synth_refuses_bad_input(tmp_path, recording):
+    runner = CliRunner()
+    result = runner.invoke(main, ["synth", "dance", str(tmp_path / "x")])
+    assert result.exit_code != 0 and "unknown scenario 'dance'" in result.output
+    result = runner.invoke(main, ["synth", "no_occlusion", str(recording), "--frames", "2"])
+    assert result.exit_code != 0 and "exists and is not empty (use --force" in result.output
+    result = runner.invoke(main, ["synth", "no_occlusion", str(tmp_path / "y"), "--frames", "9999"])
+    assert result.exit_code != 0 and "--frames must be in 1..360" in result.output
+    result = runner.invoke(main, ["synth", "no_occlusion", str(tmp_path / "z"), "--sensor", "webcam"])
+    assert result.exit_code != 0 and "unknown camera preset 'webcam'" in result.output
+
+
+def test_synth_sensor_option_changes_the_camera(tmp_path):
+    out = tmp_path / "azure"
+    result = CliRunner().invoke(main, ["synth", "top_view_arms", str(out), "--frames", "2", "--sensor", "azure_nfov",
+                                       "--procedural"])
+    assert result.exit_code == 0, result.output
+    cam = Recording(out).cameras[0]
+    assert (cam.width, cam.height) == (640, 576)
+
+
+def test_show_writes_a_picture(tmp_path, recording):
+    out = tmp_path / "frame.png"
+    result = CliRunner().invoke(main, ["show", str(recording), "--frame", "30", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    image = np.asarray(Image.open(out).convert("RGB"))
+    assert image.shape[0] > 200 and image.std() > 20  # a real picture, not a blank canvas
+    result = CliRunner().invoke(main, ["show", str(recording), "--frame", "40", "--out", str(out)])
+    assert result.exit_code != 0 and "frame 40 is out of range" in result.output
+
+
+def test_score_prints_table_one_rows(tmp_path, recording):
+    rec = Recording(recording)
+    gt = rec.groundtruth()
+    joints = gt.joints[:, 0].copy()
+    joints[:, :, 0] += 0.05  # a tracker 5 cm off along x everywhere
+    present = np.isfinite(joints[..., 0])
+    tracks = tmp_path / "tracks.csv"
+    write_tracks_csv(tracks, {7: (joints, present)})
+    result = CliRunner().invoke(main, ["score", str(recording), str(tracks)])
+    assert result.exit_code == 0, result.output
+    row = next(line for line in result.output.splitlines() if "all joints" in line)
+    assert "person 1 (track 7)" in row
+    assert " 5.00 " in row and "100.00" in row  # mean 5 cm, every frame under 10 cm
+    assert "identity switches: 0" in result.output
+
+
+def test_score_without_groundtruth_is_a_clear_error(tmp_path, recording):
+    (tmp_path / "t.csv").write_text("frame,track,joint,x,y,z,visible\n")
+    import shutil
+
+    copy = tmp_path / "nogt"
+    shutil.copytree(recording, copy)
+    (copy / "groundtruth.csv").unlink()
+    result = CliRunner().invoke(main, ["score", str(copy), str(tmp_path / "t.csv")])
+    assert result.exit_code != 0 and "no groundtruth.csv" in result.output
