@@ -1,0 +1,513 @@
+"""Stage 1: the occupancy grid, a three-state HMM per cell, and what the cameras can see.
+
+Every cell of a :class:`~occupose.grid.spec.GridSpec` runs a hidden Markov model with the
+states of the first paper (section III-A): ``O`` occupied by a static object, ``M``
+occupied by a moving object, ``E`` empty. Each frame, the cell centre is projected into
+every depth image; with ``l`` the centre's depth along that camera's optical axis and
+``d`` the measured depth at its pixel, ``epsilon = d - l`` gives the observation function
+(the paper's Fig. 3, :func:`observation_function`)::
+
+    f(epsilon) = p_occ  where |epsilon| <= band    (the surface is in the cell: occupied)
+                 p_free where epsilon > band       (the camera sees through it: empty)
+                 0.5    where epsilon < -band      (hidden behind the surface: no information)
+                 0.5    where d is 0 or the centre is outside the image or behind the camera
+
+    band = n_sigmas * depth_std(l) + h
+
+with ``depth_std`` the sensor's random depth error at that distance
+(:func:`occupose.synth.noise.depth_std` of the camera's noise model) and ``h`` half the
+cell's extent along the optical axis, ``cell / 2 * (|r_x| + |r_y| + |r_z|)`` for the
+camera's viewing direction ``r`` in world axes. The states' likelihoods are
+``B = (f, f, 1 - f)`` (O and M look alike: the aliasing the HMM resolves over time); the
+likelihoods of several cameras multiply, and a camera that does not cover a cell adds nothing.
+
+Transition matrix (rows: state at t-1, columns: state at t, order O, M, E), the paper's
+Fig. 4 with its extra M -> O transition ``psi``::
+
+          O        M              E
+    O  [ 1-alpha   0              alpha   ]   static object removed (a chair carried away)
+    M  [ psi       1-gamma-psi    gamma   ]   a moving object leaves; rarely, it settles (psi)
+    E  [ 0         beta           1-beta  ]   something enters a free cell: it is moving
+
+There is no E -> O (a new object is moving first) and no O -> M (a static object starts
+moving by leaving its cells, O -> E, and entering others, E -> M). Forward update
+``Q_t ~ (Q_{t-1}^T A) o B_t``, normalised; the cell's state is the MAP of ``Q_t``.
+
+How long until something that moved becomes background again. O and M always have the
+same likelihood, so their posterior ratio ``r = P(O) / P(M)`` does not depend on the
+observations: with ``a = (1 - alpha) / (1 - gamma - psi)`` and ``b = psi / (1 - gamma - psi)``
+it follows ``r_{t+1} = a r_t + b`` (ignoring the E -> M inflow, which dies out within a few
+frames of a cell being seen occupied). A cell entered from E starts at ``r_0 = 0``, so
+``r_t = b (a^t - 1) / (a - 1)``, and it turns O when ``r_t > 1``::
+
+    T = ln(1 + (a - 1) / b) / ln(a) = ln(1 + (gamma - alpha + psi) / psi) / ln((1 - alpha) / (1 - gamma - psi))
+      ~ (-ln psi + ln(gamma - alpha)) / ln((1 - alpha) / (1 - gamma))
+
+For the defaults (alpha 0.01, gamma 0.4, psi e^-38): ``T = (38 - 0.94) / 0.501 = 74.0``
+frames, 2.5 s at 30 fps (:func:`frames_until_static`). The same holds for a person who
+stands perfectly still: after ``T`` frames they are background.
+
+Initial distribution (``initial``, default ``(0.4, 0, 0.6)`` for O, M, E). One frame
+cannot tell a static object from a moving one, and the ratio argument above shows that the
+choice only matters for the first few frames: a cell occupied from the first frame on has
+``r_t = r_0 a^t``, so whatever ``r_0 > 0`` is, it is O after ``-ln(r_0) / ln(a)`` frames and
+stays O as long as it stays occupied; a person who walks is extracted anyway, because the
+cells they enter come from E and start at ``r = 0``. So the default puts no mass on M, and
+enough on O that after the first frame every cell seen occupied is O (the background is
+learnt from the first frame, no empty room needed: ``0.99 * 0.4 > 0.1 * 0.6``), while a cell
+that is not observed still ends up E after one prediction (``0.99 * 0.4 < 0.01 * 0.4 + 0.9
+* 0.6``: unknown space counts as empty, not as an obstacle). A person present at frame 0 is
+O where they stand at first and M wherever they move to: a walking person within the time
+their body takes to clear its first position (about 8 frames at 1.3 m/s), a person who
+stands still only once they move. Putting most mass on E instead (``initial=(q, 0, 1 - q)``
+with ``q`` small) makes everything seen occupied M for the first ``-ln(r_0) / ln(a)``
+frames: the person then, but the whole room too, and from that frame on both choices give
+the same states.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points, points_from_depth
+from occupose.grid import _kernels
+from occupose.grid.spec import GridSpec
+from occupose.synth.noise import depth_std
+
+#: Cell states (index into the last axis of ``OccupancyGrid.probabilities``).
+O, M, E = 0, 1, 2
+STATE_NAMES = ("O", "M", "E")
+#: Cell visibility from the cameras.
+UNOBSERVED, VISIBLE, HIDDEN = _kernels.UNOBSERVED, _kernels.VISIBLE, _kernels.HIDDEN
+
+ALPHA, BETA, GAMMA, PSI = 0.01, 0.1, 0.4, math.exp(-38.0)
+P_OCC, P_FREE = 0.9, 0.05
+N_SIGMAS = 3.0
+INITIAL = (0.4, 0.0, 0.6)
+#: Noise model for cameras whose intrinsics match no sensor preset (the noisier of the two).
+DEFAULT_NOISE_MODEL = "structured_light"
+#: Far range (metres) for cameras whose intrinsics match no sensor preset.
+DEFAULT_MAX_RANGE = 4.5
+#: Posterior probabilities below this are set to 0 (float32 never goes subnormal).
+FLUSH = 1e-30
+_LUT_STEP = 0.01
+_LUT_DEPTH = 12.0
+
+
+# ------------------------------------------------------------------------- the model
+
+
+def observation_function(epsilon, band, p_occ: float = P_OCC, p_free: float = P_FREE) -> np.ndarray:
+    """The paper's Fig. 3: P(observation | cell occupied) as a function of epsilon = d - l.
+
+    epsilon : (...) float, metres, measured depth minus the cell centre's depth (NaN: no
+        measurement or the cell is not in the image)
+    band : float or (...) float, metres, half width of the occupied band
+    Returns (...) float64: ``p_occ`` where |epsilon| <= band, ``p_free`` where epsilon >
+    band (seen through), 0.5 where epsilon < -band (hidden) or epsilon is NaN.
+    """
+    epsilon = np.asarray(epsilon, np.float64)
+    band = np.asarray(band, np.float64)
+    with np.errstate(invalid="ignore"):
+        return np.where(epsilon > band, p_free, np.where(epsilon >= -band, p_occ, 0.5))
+
+
+def transition_matrix(alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA,
+                      psi: float = PSI) -> np.ndarray:
+    """(3, 3) float64 transition matrix A[previous, next] over states (O, M, E); see the module docstring."""
+    for name, value in (("alpha", alpha), ("beta", beta), ("gamma", gamma), ("psi", psi)):
+        if not (isinstance(value, (int, float, np.floating)) and 0.0 <= value <= 1.0):
+            raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
+    if gamma + psi > 1.0:
+        raise ValueError(f"gamma + psi must be <= 1 (they leave state M), got {gamma} + {psi}")
+    return np.array([[1.0 - alpha, 0.0, alpha],
+                     [psi, 1.0 - gamma - psi, gamma],
+                     [0.0, beta, 1.0 - beta]])
+
+
+def frames_until_static(alpha: float = ALPHA, gamma: float = GAMMA, psi: float = PSI) -> float:
+    """Frames a cell entered from E and then seen occupied stays M before it turns O.
+
+    ``T = ln(1 + (gamma - alpha + psi) / psi) / ln((1 - alpha) / (1 - gamma - psi))`` (the
+    module docstring derives it); 74.0 for the defaults. Returns inf when psi is 0 or when
+    O does not outlast M (``alpha >= gamma + psi``).
+    """
+    transition_matrix(alpha, 0.0, gamma, psi)
+    a = (1.0 - alpha) / (1.0 - gamma - psi) if gamma + psi < 1.0 else math.inf
+    if psi == 0.0 or a <= 1.0:
+        return math.inf
+    if math.isinf(a):
+        return 0.0
+    return math.log1p((gamma - alpha + psi) / psi) / math.log(a)
+
+
+# ------------------------------------------------------------------------- geometry
+
+
+def _preset_of(camera: Camera) -> SensorSpec | None:
+    """The sensor preset whose image size and intrinsics the camera has, if any."""
+    for spec in CAMERA_PRESETS.values():
+        if (spec.width, spec.height, spec.fx, spec.fy, spec.cx, spec.cy) == (
+                camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy):
+            return spec
+    return None
+
+
+def _check_cameras(cameras) -> tuple[Camera, ...]:
+    cameras = tuple(cameras) if not isinstance(cameras, Camera) else (cameras,)
+    if not cameras or not all(isinstance(c, Camera) for c in cameras):
+        raise ValueError(f"cameras must be a non-empty sequence of occupose.camera.Camera, got {cameras!r}")
+    names = [c.name for c in cameras]
+    if len(set(names)) != len(names):
+        raise ValueError(f"camera names must be unique, got {names}")
+    return cameras
+
+
+def _max_ranges(cameras: tuple[Camera, ...], max_range) -> dict[str, float]:
+    """Far range per camera: given (float or name -> float), else the sensor preset's, else DEFAULT_MAX_RANGE."""
+    out = {}
+    for cam in cameras:
+        if max_range is None:
+            preset = _preset_of(cam)
+            value = preset.far if preset is not None else DEFAULT_MAX_RANGE
+        elif isinstance(max_range, Mapping):
+            if cam.name not in max_range:
+                raise ValueError(f"max_range has no entry for camera {cam.name!r} (it has {sorted(max_range)})")
+            value = max_range[cam.name]
+        else:
+            value = max_range
+        if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"max_range for camera {cam.name!r} must be a positive number of metres, got {value!r}")
+        out[cam.name] = float(value)
+    return out
+
+
+def _frustum(camera: Camera, far: float) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """The camera's view pyramid up to depth ``far``: (5, 3) world vertices (apex first) and its 8 edges."""
+    corners = np.array([[-0.5, -0.5], [camera.width - 0.5, -0.5],
+                        [camera.width - 0.5, camera.height - 0.5], [-0.5, camera.height - 0.5]])
+    local = np.column_stack([(corners[:, 0] - camera.cx) / camera.fx * far,
+                             (corners[:, 1] - camera.cy) / camera.fy * far, np.full(4, far)])
+    pose = camera.world_from_camera
+    vertices = np.vstack([pose[:3, 3], local @ pose[:3, :3].T + pose[:3, 3]])
+    edges = [(0, 1), (0, 2), (0, 3), (0, 4), (1, 2), (2, 3), (3, 4), (4, 1)]
+    return vertices, edges
+
+
+def _frustum_in_slab(camera: Camera, far: float, z_low: float, z_high: float) -> np.ndarray:
+    """(K, 3) vertices of the view pyramid clipped to z_low <= z <= z_high (K = 0: no overlap).
+
+    A vertex of the clipped pyramid is either a pyramid vertex inside the slab or where a
+    pyramid edge crosses one of the two planes, so their bounding box is exact.
+    """
+    vertices, edges = _frustum(camera, far)
+    inside = (vertices[:, 2] >= z_low) & (vertices[:, 2] <= z_high)
+    points = [vertices[inside]]
+    for a, b in edges:
+        za, zb = vertices[a, 2], vertices[b, 2]
+        for plane in (z_low, z_high):
+            if za != zb and min(za, zb) <= plane <= max(za, zb):
+                s = (plane - za) / (zb - za)
+                point = vertices[a] + s * (vertices[b] - vertices[a])
+                point[2] = plane
+                points.append(point[None])
+    return np.vstack(points)
+
+
+def _cells_seen(spec: GridSpec, camera: Camera, far: float) -> int:
+    """Number of cell centres that project into the camera's image at a depth in (0, far]."""
+    uv, z = pixels_from_points(spec.centers().reshape(-1, 3), camera)
+    u, v = np.floor(uv[:, 0] + 0.5), np.floor(uv[:, 1] + 0.5)
+    with np.errstate(invalid="ignore"):
+        seen = (z > 0) & (z <= far) & (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
+    return int(np.count_nonzero(seen))
+
+
+def _check_coverage(spec: GridSpec, cameras: tuple[Camera, ...], far: dict[str, float]) -> None:
+    for cam in cameras:
+        if _cells_seen(spec, cam, far[cam.name]) == 0:
+            raise ValueError(
+                f"camera {cam.name!r} sees no cell of the grid box {list(spec.origin)} - {spec.high.tolist()} "
+                f"within {far[cam.name]:g} m (camera outside the grid, or looking away from it)"
+            )
+
+
+def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: float = 2.2,
+                      max_range=None, bounds=None) -> GridSpec:
+    """The grid over what the cameras see, between the floor and ``height``.
+
+    cameras : Camera or sequence of Camera
+    cell : float, metres, cell edge
+    height : float, metres, top of the grid (the floor z = 0 is the bottom)
+    max_range : None (each camera's sensor preset far range when its intrinsics match a
+        preset, else DEFAULT_MAX_RANGE), a float or a dict camera name -> float, metres:
+        how far along its optical axis each camera's view is kept
+    bounds : None, or (low (3,), high (3,)) metres, an explicit grid box (then ``height``
+        is not used)
+    Returns the GridSpec covering the bounding box of the cameras' view pyramids clipped
+    to 0 <= z <= height (or ``bounds``), extended down to z = -cell / 2 so that the bottom
+    layer of cells is centred on the floor: the cell centres' rays then meet the floor
+    inside those cells, whereas a floor lying on the boundary between two layers reads as
+    seen through at grazing angles (the ray through a centre above it leaves the cell
+    before it reaches the floor). Raises ValueError for an empty box and for a camera
+    that sees none of it.
+    """
+    cameras = _check_cameras(cameras)
+    if not (isinstance(cell, (int, float, np.floating)) and math.isfinite(cell) and cell > 0):
+        raise ValueError(f"cell must be a positive number of metres, got {cell!r}")
+    far = _max_ranges(cameras, max_range)
+    if bounds is not None:
+        low, high = (np.asarray(b, np.float64) for b in bounds)
+        spec = GridSpec.from_bounds(low, high, cell)
+    else:
+        if not (isinstance(height, (int, float, np.floating)) and math.isfinite(height) and height > 0):
+            raise ValueError(f"height must be a positive number of metres (the grid spans z = 0 .. height), "
+                             f"got {height!r}")
+        clipped = []
+        for cam in cameras:
+            points = _frustum_in_slab(cam, far[cam.name], 0.0, float(height))
+            if len(points) == 0:
+                raise ValueError(f"camera {cam.name!r} sees nothing between the floor and z = {height:g} m "
+                                 f"within {far[cam.name]:g} m (camera outside the grid, or looking away from it)")
+            clipped.append(points)
+        points = np.vstack(clipped)
+        low = points.min(axis=0)
+        low[2] = -0.5 * cell  # the bottom layer is centred on the floor
+        spec = GridSpec.from_bounds(low, points.max(axis=0), cell)
+    _check_coverage(spec, cameras, far)
+    return spec
+
+
+_NEIGHBOURS = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)])
+
+
+def _check_states(states: np.ndarray, spec: GridSpec) -> np.ndarray:
+    states = np.asarray(states)
+    if states.shape != spec.shape or states.dtype != np.uint8:
+        raise ValueError(f"states must be a uint8 {spec.shape} array of cell states, got {states.dtype} {states.shape}")
+    return states
+
+
+def _nearest_occupied(points: np.ndarray, index: np.ndarray, states: np.ndarray, spec: GridSpec) -> np.ndarray:
+    """(P, 3) cells: for each point, the O or M cell among the 26 around ``index`` whose centre is
+    nearest, or ``index`` itself when none is occupied."""
+    candidates = index[:, None, :] + _NEIGHBOURS[None]
+    inside = np.all((candidates >= 0) & (candidates < np.asarray(spec.shape)), axis=2)
+    clipped = np.clip(candidates, 0, np.asarray(spec.shape) - 1)
+    occupied = inside & (states[clipped[..., 0], clipped[..., 1], clipped[..., 2]] != E)
+    centres = np.asarray(spec.origin) + spec.cell * (candidates + 0.5)
+    distance = np.where(occupied, np.sum((centres - points[:, None, :]) ** 2, axis=2), np.inf)
+    best = np.argmin(distance, axis=1)
+    rows = np.arange(len(points))
+    return np.where(occupied[rows, best][:, None], candidates[rows, best], index)
+
+
+def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: np.ndarray | None = None) -> np.ndarray:
+    """The grid cell of every depth pixel's back-projected 3D point (the paper's Fig. 2(d)).
+
+    depth : (H, W) float metres or uint16 raw, H, W = camera.height, camera.width (0 = no measurement)
+    states : optional (nx, ny, nz) uint8 cell states. A measured point inside a cell the
+        grid holds empty lies on an object's silhouette edge: the ray through the cell's
+        centre passes beside the object, so the cell reads as seen through although the
+        object covers part of it. With ``states``, such a point is given to the nearest
+        (by centre distance) O or M cell among the 26 around its own, if there is one.
+    Returns (H, W) int64: flat cell index ``(i * ny + j) * nz + k`` into ``spec.shape``, -1
+    where there is no measurement or the point is outside the grid.
+    """
+    points, pixels = points_from_depth(depth, camera)
+    index, inside = spec.cells_from_points(points)
+    points, pixels, index = points[inside], pixels[inside], index[inside]
+    if states is not None:
+        states = _check_states(states, spec)
+        empty = states[index[:, 0], index[:, 1], index[:, 2]] == E
+        index[empty] = _nearest_occupied(points[empty], index[empty], states, spec)
+    nx, ny, nz = spec.shape
+    out = np.full(camera.height * camera.width, -1, np.int64)
+    out[pixels] = (index[:, 0] * ny + index[:, 1]) * nz + index[:, 2]
+    return out.reshape(camera.height, camera.width)
+
+
+def foreground_from_grid(states: np.ndarray, spec: GridSpec, depth: np.ndarray, camera: Camera) -> np.ndarray:
+    """Pixels whose back-projected 3D point lies in a moving cell (the paper's Fig. 2(d)).
+
+    states : (nx, ny, nz) uint8 cell states (points in E cells go to their nearest occupied
+        neighbour, see :func:`cells_from_depth`), or a bool cell mask (used as is)
+    spec : GridSpec of ``states``; depth : (H, W) float metres or uint16 raw; camera : Camera
+    Returns (H, W) bool foreground.
+    """
+    states = np.asarray(states)
+    if states.dtype == np.bool_:
+        if states.shape != spec.shape:
+            raise ValueError(f"cell mask must have the grid's shape {spec.shape}, got {states.shape}")
+        mask, index = states, cells_from_depth(depth, camera, spec)
+    else:
+        mask = _check_states(states, spec) == M
+        index = cells_from_depth(depth, camera, spec, states)
+    return np.where(index >= 0, mask.reshape(-1)[np.maximum(index, 0)], False)
+
+
+# ------------------------------------------------------------------------- the grid
+
+
+class OccupancyGrid:
+    """The per-cell HMM and visibility of a grid seen by depth cameras, frame after frame.
+
+    spec : GridSpec (see :func:`spec_from_cameras`)
+    cameras : Camera or sequence of Camera (unique names)
+    noise_models : None or dict camera name -> noise model name of :mod:`occupose.synth.noise`
+        (``"structured_light"``, ``"tof"``, ``"none"``): sets each camera's depth tolerance.
+        Default: the camera's sensor preset's model when its intrinsics match a preset,
+        else DEFAULT_NOISE_MODEL.
+    alpha, beta, gamma, psi : transition probabilities (module docstring)
+    p_occ, p_free : the observation function's levels; n_sigmas : band width in depth standard deviations
+    initial : (3,) initial distribution over (O, M, E), summing to 1 (module docstring)
+    max_range : as in :func:`spec_from_cameras`, used to check each camera sees part of the grid
+
+    After :meth:`update`: ``states`` (nx, ny, nz) uint8 MAP state (O, M, E),
+    ``probabilities`` (nx, ny, nz, 3) float32 posterior over (O, M, E), ``visibility``
+    (nx, ny, nz) uint8 (VISIBLE, HIDDEN, UNOBSERVED), ``num_updates`` frames seen.
+    """
+
+    def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str] | None = None, *,
+                 alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
+                 p_occ: float = P_OCC, p_free: float = P_FREE, n_sigmas: float = N_SIGMAS,
+                 initial=INITIAL, max_range=None):
+        if not isinstance(spec, GridSpec):
+            raise ValueError(f"spec must be a GridSpec, got {type(spec).__name__}")
+        self.spec = spec
+        self.cameras = _check_cameras(cameras)
+        self.transition = transition_matrix(alpha, beta, gamma, psi)
+        self.alpha, self.beta, self.gamma, self.psi = float(alpha), float(beta), float(gamma), float(psi)
+        if not (0.5 < p_occ <= 1.0 and 0.0 <= p_free < 0.5):
+            raise ValueError(f"need 0.5 < p_occ <= 1 and 0 <= p_free < 0.5, got p_occ={p_occ!r}, p_free={p_free!r}")
+        if not (math.isfinite(n_sigmas) and n_sigmas >= 0):
+            raise ValueError(f"n_sigmas must be a number >= 0, got {n_sigmas!r}")
+        self.p_occ, self.p_free, self.n_sigmas = float(p_occ), float(p_free), float(n_sigmas)
+        initial = np.asarray(initial, np.float64)
+        if initial.shape != (3,) or np.any(initial < 0) or abs(initial.sum() - 1.0) > 1e-6:
+            raise ValueError(f"initial must be 3 probabilities for (O, M, E) summing to 1, got {initial.tolist()}")
+        self.initial = initial
+        names = [c.name for c in self.cameras]
+        if noise_models is None:
+            noise_models = {}
+        elif not isinstance(noise_models, Mapping) or set(noise_models) - set(names):
+            raise ValueError(f"noise_models must be a dict camera name -> noise model name for cameras {names}, "
+                             f"got {noise_models!r}")
+        self.noise_models = {}
+        for cam in self.cameras:
+            preset = _preset_of(cam)
+            model = noise_models.get(cam.name, preset.noise if preset is not None else DEFAULT_NOISE_MODEL)
+            depth_std(1.0, model)  # raises with the valid names
+            self.noise_models[cam.name] = model
+        _check_coverage(spec, self.cameras, _max_ranges(self.cameras, max_range))
+        self._camera_arrays()
+        self._probabilities = np.empty(spec.shape + (3,), np.float32)
+        self._probabilities[...] = initial
+        self._states = np.full(spec.shape, int(np.argmax(initial)), np.uint8)
+        self._visibility = np.zeros(spec.shape, np.uint8)
+        self.num_updates = 0
+
+    def _camera_arrays(self) -> None:
+        """Per-camera arrays of the kernel (module docstring of occupose.grid._kernels)."""
+        count = len(self.cameras)
+        self._rotations = np.empty((count, 3, 3))
+        self._translations = np.empty((count, 3))
+        self._intrinsics = np.empty((count, 4))
+        self._sizes = np.empty((count, 2), np.int64)
+        self._offsets = np.zeros(count, np.int64)
+        self._half_extents = np.empty(count)
+        lut_depths = np.arange(int(round(_LUT_DEPTH / _LUT_STEP)) + 1) * _LUT_STEP
+        self._sigma_lut = np.empty((count, lut_depths.size))
+        offset = 0
+        for c, cam in enumerate(self.cameras):
+            pose = cam.camera_from_world
+            self._rotations[c] = pose[:3, :3]
+            self._translations[c] = pose[:3, 3]
+            self._intrinsics[c] = (cam.fx, cam.fy, cam.cx, cam.cy)
+            self._sizes[c] = (cam.width, cam.height)
+            self._offsets[c] = offset
+            offset += cam.width * cam.height
+            self._half_extents[c] = 0.5 * self.spec.cell * np.abs(pose[2, :3]).sum()
+            self._sigma_lut[c] = depth_std(lut_depths, self.noise_models[cam.name])
+        self._depth = np.empty(offset, np.float32)
+
+    def band(self, depth_l, camera: str) -> np.ndarray:
+        """Half width (metres) of the occupied band for cells at depth ``depth_l`` (metres) from camera ``camera``."""
+        c = [cam.name for cam in self.cameras].index(camera)
+        m = np.minimum((np.asarray(depth_l, np.float64) / _LUT_STEP).astype(np.int64), self._sigma_lut.shape[1] - 1)
+        return self.n_sigmas * self._sigma_lut[c, m] + self._half_extents[c]
+
+    def _check_depths(self, depths: Mapping[str, np.ndarray]) -> None:
+        names = [c.name for c in self.cameras]
+        if not isinstance(depths, Mapping) or set(depths) != set(names):
+            got = sorted(depths) if isinstance(depths, Mapping) else type(depths).__name__
+            raise ValueError(f"depths must be a dict with one image per camera {names}, got {got}")
+        for c, cam in enumerate(self.cameras):
+            image = np.asarray(depths[cam.name])
+            if image.shape != (cam.height, cam.width):
+                raise ValueError(f"depth image for camera {cam.name!r} must have shape ({cam.height}, {cam.width}), "
+                                 f"got {image.shape}")
+            if image.dtype not in (np.float32, np.float64):
+                raise ValueError(f"depth image for camera {cam.name!r} must be float32 metres, got {image.dtype} "
+                                 f"(raw uint16 depth: multiply by camera.depth_scale)")
+            start = self._offsets[c]
+            self._depth[start:start + image.size] = image.reshape(-1)
+
+    def update(self, depths: Mapping[str, np.ndarray]) -> None:
+        """Take one frame: depths is a dict camera name -> (H, W) float32 metres (0 = no measurement).
+
+        Runs one fused numba kernel over all cells (it releases the GIL, so another thread
+        can work meanwhile).
+        """
+        self._check_depths(depths)
+        nx, ny, nz = self.spec.shape
+        _kernels.update_grid(
+            np.asarray(self.spec.origin), self.spec.cell, nx, ny, nz, self._rotations, self._translations,
+            self._intrinsics, self._sizes, self._offsets, self._depth, self._sigma_lut, _LUT_STEP,
+            self._half_extents, self.n_sigmas, self.p_occ, self.p_free, self.transition, FLUSH,
+            self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
+        )
+        self.num_updates += 1
+
+    @property
+    def states(self) -> np.ndarray:
+        """(nx, ny, nz) uint8 MAP state per cell: O, M or E (read-only view)."""
+        view = self._states.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def probabilities(self) -> np.ndarray:
+        """(nx, ny, nz, 3) float32 posterior over (O, M, E) per cell (read-only view)."""
+        view = self._probabilities.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def visibility(self) -> np.ndarray:
+        """(nx, ny, nz) uint8 per cell in the last frame: VISIBLE (in front of or on the measured
+        surface for some camera), HIDDEN (behind it for every camera that measures it), UNOBSERVED
+        (no camera measures its pixel). Read-only view; all UNOBSERVED before the first update."""
+        view = self._visibility.view()
+        view.flags.writeable = False
+        return view
+
+    def moving_mask(self) -> np.ndarray:
+        """(nx, ny, nz) bool: cells whose MAP state is M."""
+        return self._states == M
+
+    def visibility_at(self, points: np.ndarray) -> np.ndarray:
+        """Visibility of the cells containing world points.
+
+        points : (N, 3) float, metres, world frame
+        Returns (N,) uint8: VISIBLE, HIDDEN or UNOBSERVED (also for points outside the grid).
+        """
+        points = np.asarray(points, np.float64)
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise ValueError(f"points must have shape (N, 3), got {points.shape}")
+        index, inside = self.spec.cells_from_points(points)
+        out = self._visibility[index[:, 0], index[:, 1], index[:, 2]]
+        return np.where(inside, out, UNOBSERVED).astype(np.uint8)
