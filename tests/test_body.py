@@ -1,13 +1,20 @@
 """Tests of occupose.body: model tables, forward kinematics (kernel vs NumPy reference and
-hand-computed poses)."""
+hand-computed poses), pose fitting, size estimation and the diffusion motion model."""
 
 import math
 
 import numpy as np
 import pytest
 
-from occupose.body import BODY_MODELS, body_model, capsules_from_poses, joints_from_poses
+from scipy import stats
+
+from occupose.body import (BODY_MODELS, body_model, capsules_from_poses, diffuse, diffusion_scales,
+                           dims_from_observation, joints_from_poses, pose_from_joints, root_drift,
+                           standing_pose)
+from occupose.camera import points_from_depth
 from occupose.joints import JOINT_INDEX as J
+from occupose.synth.generate import frames
+from occupose.synth.scenarios import build_scenario
 from occupose.synth import motion as sm
 from occupose.synth.motion import DEFAULT_DIMS
 
@@ -195,3 +202,181 @@ def test_poses_are_checked():
         capsules_from_poses(m, np.zeros((3, 25)))
     with pytest.raises(ValueError, match="BodyModel"):
         joints_from_poses("upper", np.zeros((1, 17)))
+
+
+# ---------------------------------------------------------------------------------------
+# Pose fitting
+
+
+def _fit_errors(model, joints):
+    """Largest joint error (metres) of the fitted pose of each frame (T, 15, 3)."""
+    used = model.reported_joints
+    out = []
+    for frame in joints:
+        pose = pose_from_joints(model, frame)
+        assert np.all(pose >= model.limits[:, 0]) and np.all(pose <= model.limits[:, 1])
+        fitted = joints_from_poses(model, pose[None])[0]
+        out.append(np.linalg.norm(fitted[used] - frame[used], axis=-1).max())
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def procedural_joints():
+    """Walking, turning, waving, folding the arms, raising an arm, sitting and standing up."""
+    dims = D.scaled(1.8)
+    b = sm.MotionBuilder((0.5, -1.0), 0.3, dims=dims)
+    b.walk([(2.0, 0.5), (3.0, 2.0)]).turn(2.0).wave("right").gesture("cross").gesture("raise", "left")
+    b.sit_down(0.45).wave("both").stand_up()
+    return dims, b.joints()[::12]
+
+
+@pytest.mark.parametrize("name", ["full", "upper"])
+def test_pose_from_joints_reproduces_procedural_motion(name, procedural_joints):
+    dims, joints = procedural_joints
+    errors = _fit_errors(body_model(name, dims), joints)
+    assert len(errors) > 40 and errors.max() < 0.02  # measured: 6 mm (full), 3 mm (upper)
+
+
+def test_pose_from_joints_recovers_the_pose(rng):
+    """Joints of a model pose give back that pose (where the joints determine it)."""
+    m = BODY_MODELS["full"]
+    pose = standing_pose(m, (1.0, -2.0), 2.5)
+    for name, value in (("left_shoulder_flex", 1.2), ("left_shoulder_rot", 0.6), ("left_elbow", 1.1),
+                        ("trunk_lean", 0.3), ("trunk_side", -0.1), ("right_hip_flex", 0.7), ("right_knee", 0.9),
+                        ("right_hip_rot", 0.3), ("neck_flex", 0.4), ("neck_side", 0.2)):
+        pose[m.dof(name)] = value
+    fitted = pose_from_joints(m, joints_from_poses(m, pose[None])[0])
+    determined = np.array([n != "neck_twist" for n in m.dof_names])
+    np.testing.assert_allclose(fitted[determined], pose[determined], atol=1e-4)
+
+
+def test_pose_from_joints_wraps_heading_and_checks_input():
+    m = BODY_MODELS["upper"]
+    pose = standing_pose(m, heading=3.0 + 2.0 * math.pi)
+    assert pose[m.dof("heading")] == pytest.approx(3.0, abs=1e-6)
+    joints = joints_from_poses(m, pose[None])[0]        # hips, knees, ankles are NaN: ignored
+    assert pose_from_joints(m, joints)[m.dof("heading")] == pytest.approx(3.0, abs=1e-6)
+    joints[J["left_wrist"]] = np.nan
+    with pytest.raises(ValueError, match="left_wrist"):
+        pose_from_joints(m, joints)
+    with pytest.raises(ValueError, match=r"\(15, 3\)"):
+        pose_from_joints(m, np.zeros((14, 3)))
+
+
+@pytest.mark.parametrize("clip_name, models", [("dataset-1_walk_normal_001", ("full", "upper")),
+                                                 ("dataset-2_wave-right-hand_active_001", ("full",))])
+def test_pose_from_joints_on_real_mocap(mocap, clip_name, models):
+    from occupose.mocap import canonical_from_clip, find_clip, load_clip
+
+    joints = canonical_from_clip(load_clip(find_clip(clip_name)))
+    dims = sm.dims_from_joints(joints)
+    for name in models:
+        errors = _fit_errors(body_model(name, dims), joints[::15])
+        # measured: walk 1.0 cm (full) / 1.8 cm (upper), wave 3.0 cm (full); a rigid torso
+        # cannot shrug one shoulder, and the upper model has no sideways lean
+        assert errors.max() < 0.04, name
+
+
+# ---------------------------------------------------------------------------------------
+# Size from observation
+
+
+def _first_points(seed: int):
+    scenario = build_scenario("no_occlusion", seed=seed, use_mocap=False)
+    points = []
+    for frame in frames(scenario, seed=0, num_frames=2):
+        for cam in scenario.cameras:
+            depth = np.where(frame.rendered[cam.name].person == 1, frame.depth[cam.name], 0.0).astype(np.float32)
+            points.append(points_from_depth(depth, cam)[0])
+    return np.concatenate(points), sm.dims_from_joints(scenario.people[0].joints[:30]).height
+
+
+def test_dims_from_observation_on_rendered_people():
+    heights = []
+    for seed in (3, 5):  # a 1.88 m and a 1.68 m person
+        points, height = _first_points(seed)
+        size = dims_from_observation(points)
+        assert size.dims.height == pytest.approx(height, abs=0.05)   # measured: -3.2 cm and 0.0 cm
+        assert 0.85 <= size.girth <= 1.2
+        heights.append(size.dims.height)
+    assert heights[0] - heights[1] > 0.12
+
+
+def test_dims_from_observation_on_a_model_surface(rng):
+    """Points on the standing model's cones: stature, floor offset and a girth near 1."""
+    m = body_model("full", D.scaled(1.65))
+    a, b = capsules_from_poses(m, standing_pose(m)[None])
+    t = rng.random((4000, 1))
+    k = rng.integers(m.num_capsules, size=4000)
+    r = m.capsule_radii[k, 0] + t[:, 0] * (m.capsule_radii[k, 1] - m.capsule_radii[k, 0])
+    direction = rng.standard_normal((4000, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    points = a[0, k] + t * (b[0, k] - a[0, k]) + r[:, None] * direction
+    top = points[:, 2].max()
+    size = dims_from_observation(points + [0, 0, 0.3], floor_z=0.3)
+    assert size.dims.height == pytest.approx(top, abs=0.02)
+    assert size.girth == pytest.approx(1.0, abs=0.1)
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        dims_from_observation(np.zeros((5, 3)))
+
+
+# ---------------------------------------------------------------------------------------
+# Motion model
+
+
+def test_diffusion_scales():
+    m = BODY_MODELS["full"]
+    s = diffusion_scales(m)
+    assert s[m.dof("x")] == 0.02 and s[m.dof("left_elbow")] == 0.10
+    s60 = diffusion_scales(m, fps=60.0, shoulder=0.3, left_elbow=0.5)
+    assert s60[m.dof("x")] == pytest.approx(0.01)
+    assert s60[m.dof("right_shoulder_abd")] == 0.3 and s60[m.dof("left_elbow")] == 0.5
+    with pytest.raises(ValueError, match="valid"):
+        diffusion_scales(m, elbows=0.1)
+
+
+def test_diffuse_statistics_and_seed(rng):
+    limits = np.array([[-10.0, 10.0], [0.0, 1.0]])
+    poses = np.tile([1.0, 0.5], (20000, 1))
+    out = diffuse(poses, [0.2, 0.01], limits, np.random.default_rng(3))
+    np.testing.assert_allclose(out.mean(axis=0), [1.0, 0.5], atol=0.005)
+    np.testing.assert_allclose(out.std(axis=0), [0.2, 0.01], rtol=0.03)
+    np.testing.assert_array_equal(out, diffuse(poses, [0.2, 0.01], limits, np.random.default_rng(3)))
+    drift = np.array([0.5, 0.0])
+    moved = diffuse(poses, [0.0, 0.0], limits, rng, drift=drift)
+    np.testing.assert_array_equal(moved, poses + drift)
+
+
+def test_diffuse_reflects_rejects_clips_and_wraps(rng):
+    limits = np.array([[0.0, 1.0], [-math.pi, math.pi]])
+    periodic = np.array([False, True])
+    poses = np.tile([0.95, 3.0], (20000, 1))
+    reflected = diffuse(poses, [0.1, 0.5], limits, rng, periodic=periodic)
+    assert reflected[:, 0].max() <= 1.0 and reflected[:, 1].min() >= -math.pi and reflected[:, 1].max() < math.pi
+    assert np.mean(reflected[:, 1] < 0) > 0.3           # heading wrapped past pi, not stopped
+    one = diffuse(np.array([[0.95, 0.0]]), [0.0, 0.0], limits, rng, drift=[0.35, 0.0])
+    assert one[0, 0] == pytest.approx(0.7)              # 1.3 folds back to 0.7
+    rejected = diffuse(poses, [0.1, 0.5], limits, rng, periodic=periodic, mode="reject")
+    expected = stats.truncnorm((0.0 - 0.95) / 0.1, (1.0 - 0.95) / 0.1, loc=0.95, scale=0.1).mean()
+    assert rejected[:, 0].mean() == pytest.approx(expected, abs=0.003)
+    clipped = diffuse(poses, [0.1, 0.5], limits, rng, periodic=periodic, mode="clip")
+    assert np.mean(clipped[:, 0] == 1.0) == pytest.approx(0.31, abs=0.02)  # P(N > 0.5 sd)
+    with pytest.raises(ValueError, match="reflect, reject, clip"):
+        diffuse(poses, [0.1, 0.5], limits, rng, mode="bounce")
+
+
+def test_diffuse_keeps_model_poses_valid(rng):
+    m = BODY_MODELS["upper"]
+    poses = np.tile(standing_pose(m), (500, 1))
+    for _ in range(20):
+        poses = diffuse(poses, diffusion_scales(m, scale=3.0), m.limits, rng, periodic=m.periodic)
+    assert np.all(poses >= m.limits[:, 0]) and np.all(poses <= m.limits[:, 1])
+
+
+def test_root_drift():
+    m = BODY_MODELS["full"]
+    previous = standing_pose(m, (0.0, 0.0))
+    current = standing_pose(m, (0.04, -0.02), heading=0.1)
+    drift = root_drift(m, previous, current, damping=0.5)
+    np.testing.assert_allclose(drift[:3], [0.02, -0.01, 0.0], atol=1e-12)
+    assert not drift[3:].any()
