@@ -19,8 +19,9 @@ along the slice's principal horizontal axis between the ``BREADTH_QUANTILES``. C
 measured on the synthetic renders: with the arms hanging beside the chest the breadth is
 mostly shoulder width plus arm thickness, so this ratio follows the frame more than the
 flesh (it came out 0.96 .. 1.0 from a front camera and 0.92 .. 0.94 from a ceiling
-camera for bodies whose chest radii span 0.7 .. 1.07 of the average); seen only in profile it measures the chest's depth and comes out low. It is
-clipped to ``GIRTH_RANGE`` and is a starting value, not a measurement.
+camera for bodies whose chest radii span 0.7 .. 1.07 of the average); seen only in
+profile it measures the chest's depth and comes out low. It is clipped to ``GIRTH_RANGE``
+and is a starting value, not a measurement.
 """
 
 from __future__ import annotations
