@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from occupose.filters import FILTERS, RESAMPLING, ess, filter_options, make_filter, mean_pose, normalised_weights, resample
+from occupose.filters import (FILTERS, RESAMPLING, ess, filter_options, make_filter, mean_pose, normalised_weights,
+                              resample)
 from occupose.filters import _kernels
 from occupose.filters.base import apply_limits, limit_modes
 
@@ -101,14 +102,14 @@ def test_systematic_and_residual_keep_the_deterministic_copies(rng):
     weights = rng.dirichlet(np.ones(50))
     n = 50
     for _ in range(100):
-        systematic = np.bincount(RESAMPLING["systematic"](weights, n, rng), minlength=50)
+        systematic = np.bincount(RESAMPLING["systematic"](np.log(weights), n, rng), minlength=50)
         assert np.all((systematic >= np.floor(n * weights)) & (systematic <= np.ceil(n * weights)))
-        residual = np.bincount(RESAMPLING["residual"](weights, n, rng), minlength=50)
+        residual = np.bincount(RESAMPLING["residual"](np.log(weights), n, rng), minlength=50)
         assert np.all(residual >= np.floor(n * weights)) and residual.sum() == n
 
 
 def test_residual_without_remainder_is_exact(rng):
-    indices = RESAMPLING["residual"](np.array([0.5, 0.25, 0.25]), 8, rng)
+    indices = RESAMPLING["residual"](np.log([0.5, 0.25, 0.25]), 8, rng)
     assert indices.tolist() == [0, 0, 0, 0, 1, 1, 2, 2]
 
 
@@ -144,6 +145,32 @@ def test_annealing_exponent_matches_numpy_bisection(rng):
         beta, survival = _kernels.annealing_exponent(values, target)
         assert survival == pytest.approx(target, rel=1e-5)
         assert beta == pytest.approx(_annealing_reference(values, target), rel=1e-4)
+
+
+def test_ancestor_search_matches_numpy_searchsorted(rng):
+    for case in range(10):
+        log_weights = rng.standard_normal(300) * 20 - 1e3
+        log_weights[rng.random(300) < 0.2 * (case % 2)] = -np.inf
+        points = np.sort(rng.random(500)) if case % 3 else rng.random(500)
+        expected = np.searchsorted(np.cumsum(normalised_weights(log_weights)), points, side="right")
+        found = _kernels.ancestors_from_points(log_weights, points, np.empty(500, np.int64))
+        np.testing.assert_array_equal(found, np.minimum(expected, 299))
+    equal = _kernels.ancestors_from_points(np.full(4, -np.inf), np.array([0.1, 0.3, 0.6, 0.9]), np.empty(4, np.int64))
+    assert equal.tolist() == [0, 1, 2, 3]
+
+
+def test_layer_weights_match_numpy(rng):
+    values = rng.standard_normal((100, 6)) * 3
+    values[5, 2] = -np.inf
+    parts = np.array([0, 2, 5])
+    total = values[:, parts].sum(axis=1)
+    log_weights, beta, survival = _kernels.layer_weights(values, parts, False, 0.5, np.empty(100))
+    assert beta == 1.0 and survival == pytest.approx(ess(total) / 100)
+    np.testing.assert_array_equal(log_weights, total)
+    log_weights, beta, survival = _kernels.layer_weights(values, parts, True, 0.3, np.empty(100))
+    assert beta == pytest.approx(_annealing_reference(total, 0.3), rel=1e-4)
+    assert survival == pytest.approx(ess(log_weights) / 100) and survival == pytest.approx(0.3, rel=1e-5)
+    np.testing.assert_allclose(log_weights, beta * total)
 
 
 def test_annealing_exponent_out_of_reach_targets():

@@ -15,7 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from occupose.filters import _kernels
-from occupose.filters.resampling import check_scheme, normalised_weights, resample
+from occupose.filters.resampling import RESAMPLING, check_scheme, normalised_weights
 
 TWO_PI = 2.0 * np.pi
 
@@ -133,7 +133,8 @@ def check_groups(groups, name: str, num_dofs: int) -> list[tuple[np.ndarray, np.
         out.append((dofs, parts))
     every = np.concatenate([dofs for dofs, _ in out])
     if not np.array_equal(np.sort(every), np.arange(num_dofs)):
-        raise ValueError(f"problem.{name} must hold every DOF 0..{num_dofs - 1} exactly once, got {sorted(every.tolist())}")
+        raise ValueError(f"problem.{name} must hold every DOF 0..{num_dofs - 1} exactly once, "
+                         f"got {sorted(every.tolist())}")
     return out
 
 
@@ -188,8 +189,9 @@ class ParticleFilter:
         spread : (D,) float64 >= 0 standard deviation of the Gaussian around it (or a scalar)
         """
         pose = np.asarray(pose, dtype=np.float64).reshape(-1)
-        spread = np.broadcast_to(np.asarray(spread, dtype=np.float64), (self.num_dofs,)) \
-            if np.ndim(spread) == 0 else np.asarray(spread, dtype=np.float64).reshape(-1)
+        spread = np.asarray(spread, dtype=np.float64)
+        if spread.ndim == 0:
+            spread = np.full(self.num_dofs, float(spread))
         if pose.shape != (self.num_dofs,) or not np.isfinite(pose).all():
             raise ValueError(f"pose must be ({self.num_dofs},) finite, got shape {pose.shape}")
         if spread.shape != (self.num_dofs,) or not (np.isfinite(spread).all() and (spread >= 0).all()):
@@ -281,22 +283,22 @@ class ParticleFilter:
             for name, groups in self._groups:
                 top = max(parts.max() for _, parts in groups)
                 if top >= values.shape[1]:
-                    raise ValueError(f"problem.{name} names part {top} but log_likelihood gives {values.shape[1]} parts")
+                    raise ValueError(f"problem.{name} names part {top} but log_likelihood gives "
+                                     f"{values.shape[1]} parts")
             self._num_parts = values.shape[1]
         elif values.shape[1] != self._num_parts:
             raise ValueError(f"problem.log_likelihood returned {values.shape[1]} parts, earlier {self._num_parts}")
-        if np.isnan(values).any() or (values == np.inf).any():
+        if not values.max() < np.inf:  # NaN anywhere propagates to the maximum
             raise ValueError("problem.log_likelihood returned NaN or +inf")
         self.diagnostics["likelihood_evaluations"] += p
         return values
 
-    def _resample(self, log_weights: np.ndarray) -> np.ndarray:
-        """Ancestor indices (P,) from log-weights (no resampling, the identity, for equal weights)."""
+    def _resample(self, log_weights: np.ndarray) -> np.ndarray | None:
+        """Ancestor indices (P,) from checked log-weights; None for equal weights (nothing to do)."""
         start = time.perf_counter()
-        if log_weights.max() == log_weights.min():
-            indices = np.arange(self.num_particles)
-        else:
-            indices = resample(log_weights, self.rng, self.resampling)
+        indices = None
+        if log_weights.max() != log_weights.min():
+            indices = RESAMPLING[self.resampling](log_weights, self.num_particles, self.rng)
         self._timed("resample", start)
         return indices
 

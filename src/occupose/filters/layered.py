@@ -46,7 +46,7 @@ class _LayeredFilter(ParticleFilter):
                  survival: float = 0.5):
         super().__init__(problem, num_particles, rng, resampling=resampling)
         if stages is None:
-            stages = [(np.arange(self.num_dofs), None)]
+            stages = [(np.arange(self.num_dofs), np.empty(0, np.int64))]  # every DOF, every part
         self.stages = stages
         layers = np.atleast_1d(np.asarray(num_layers))
         if layers.ndim != 1 or layers.size not in (1, len(stages)) or not np.issubdtype(layers.dtype, np.integer) \
@@ -64,22 +64,19 @@ class _LayeredFilter(ParticleFilter):
             dofs = dofs[active[dofs]]
             if dofs.size == 0:
                 continue
-            scale = 1.0
+            stage_std = std[dofs]
             for _ in range(num_layers):
-                self.particles = self.particles[self._resample(self.log_weights)]
-                self._diffuse(dofs, std[dofs] * scale)
+                indices = self._resample(self.log_weights)
+                if indices is not None:
+                    self.particles = self.particles[indices]
+                self._diffuse(dofs, stage_std)
                 values = self._evaluate()
                 start = time.perf_counter()
-                total = values.sum(axis=1) if parts is None else values[:, parts].sum(axis=1)
-                if self.annealed:
-                    beta, survival = _kernels.annealing_exponent(total, self.survival)
-                    self.log_weights = beta * total
-                    scale *= np.sqrt(survival)
-                else:
-                    beta, self.log_weights = 1.0, total
-                    survival = self._survival(total[:, None])[0]
-                diagnostics["betas"].append(float(beta))
-                diagnostics["layer_survival"].append(float(survival))
+                _, beta, survival = _kernels.layer_weights(values, parts, self.annealed, self.survival,
+                                                           self.log_weights)
+                stage_std = stage_std * np.sqrt(survival)
+                diagnostics["betas"].append(beta)
+                diagnostics["layer_survival"].append(survival)
                 self._timed("weight", start)
         if values is not None:
             diagnostics["survival"] = self._survival(values)

@@ -50,6 +50,8 @@ class PartBasedFilter(ParticleFilter):
             if dofs.size == 0:
                 continue
             indices = self._resample(self.log_weights[:, g])
+            if indices is None:
+                indices = np.arange(self.num_particles)
             if self.shuffle:
                 start = time.perf_counter()
                 indices = indices[self.rng.permutation(self.num_particles)]

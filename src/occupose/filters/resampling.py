@@ -2,7 +2,8 @@
 
 Weights arrive as log-weights (any additive constant; ``-inf`` = weight 0) and are
 normalised with the log-sum-exp trick, so likelihoods far below ``exp(-745)`` still
-resample correctly. Every scheme draws ``num`` ancestor indices with
+resample correctly. Each scheme draws its points in [0, 1) from the Generator and a numba
+kernel finds their ancestors in the cumulative weights. Every scheme draws ``num`` ancestor indices with
 ``E[count_i] = num * w_i`` (unbiased); systematic and stratified draws have a lower
 variance than multinomial, residual copies ``floor(num * w_i)`` deterministically and
 draws the rest multinomially (Douc, Cappe & Moulines 2005, "Comparison of resampling
@@ -15,6 +16,21 @@ from collections.abc import Callable
 
 import numpy as np
 
+from occupose.filters import _kernels
+
+
+def _checked(log_weights) -> np.ndarray:
+    """(N,) float64 log-weights, with a clear error for a wrong shape, NaN or +inf."""
+    log_weights = np.asarray(log_weights, dtype=np.float64)
+    if log_weights.ndim != 1 or log_weights.size == 0:
+        raise ValueError(f"log_weights must be a non-empty (N,) array, got shape {log_weights.shape}")
+    top = log_weights.max()  # NaN anywhere propagates
+    if np.isnan(top):
+        raise ValueError("log_weights contain NaN")
+    if top == np.inf:
+        raise ValueError("log_weights contain +inf")
+    return log_weights
+
 
 def normalised_weights(log_weights) -> np.ndarray:
     """Weights summing to 1 from log-weights.
@@ -22,14 +38,8 @@ def normalised_weights(log_weights) -> np.ndarray:
     log_weights : (N,) float, natural log, any additive constant; -inf = weight 0
     Returns (N,) float64. All -inf (no particle explains the data) gives uniform weights.
     """
-    log_weights = np.asarray(log_weights, dtype=np.float64)
-    if log_weights.ndim != 1 or log_weights.size == 0:
-        raise ValueError(f"log_weights must be a non-empty (N,) array, got shape {log_weights.shape}")
+    log_weights = _checked(log_weights)
     top = log_weights.max()
-    if np.isnan(top) or np.isnan(log_weights).any():
-        raise ValueError("log_weights contain NaN")
-    if top == np.inf:
-        raise ValueError("log_weights contain +inf")
     if top == -np.inf:
         return np.full(log_weights.size, 1.0 / log_weights.size)
     weights = np.exp(log_weights - top)
@@ -51,59 +61,57 @@ def _check_num(num) -> int:
     return int(num)
 
 
-def _search(cumulative: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Indices i with cumulative[i-1] <= point < cumulative[i] (points scaled to the total)."""
-    indices = np.searchsorted(cumulative, points * cumulative[-1], side="right")
-    return np.minimum(indices, cumulative.size - 1)
+def multinomial(log_weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
+    """``num`` independent draws from the categorical distribution of the weights.
 
-
-def multinomial(weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
-    """``num`` independent draws from the categorical distribution ``weights``.
-
-    weights : (N,) float64, non-negative, summing to 1
+    log_weights : (N,) float64, checked (no NaN / +inf)
     Returns (num,) int64 ancestor indices (unsorted).
     """
-    return _search(np.cumsum(weights), rng.random(_check_num(num)))
+    points = rng.random(_check_num(num))
+    return _kernels.ancestors_from_points(log_weights, points, np.empty(points.size, np.int64))
 
 
-def systematic(weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
+def systematic(log_weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
     """One uniform offset u, points ``(u + j) / num``: each count within 1 of ``num * w_i``.
 
-    weights : (N,) float64, non-negative, summing to 1
+    log_weights : (N,) float64, checked (no NaN / +inf)
     Returns (num,) int64 ancestor indices, sorted.
     """
     num = _check_num(num)
-    return _search(np.cumsum(weights), (rng.random() + np.arange(num)) / num)
+    points = (rng.random() + np.arange(num)) / num
+    return _kernels.ancestors_from_points(log_weights, points, np.empty(num, np.int64))
 
 
-def stratified(weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
+def stratified(log_weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
     """One uniform point in each of the ``num`` strata ``[j / num, (j + 1) / num)``.
 
-    weights : (N,) float64, non-negative, summing to 1
+    log_weights : (N,) float64, checked (no NaN / +inf)
     Returns (num,) int64 ancestor indices, sorted.
     """
     num = _check_num(num)
-    return _search(np.cumsum(weights), (rng.random(num) + np.arange(num)) / num)
+    points = (rng.random(num) + np.arange(num)) / num
+    return _kernels.ancestors_from_points(log_weights, points, np.empty(num, np.int64))
 
 
-def residual(weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
+def residual(log_weights: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
     """``floor(num * w_i)`` copies of each particle, the remaining draws multinomial on the residuals.
 
-    weights : (N,) float64, non-negative, summing to 1
+    log_weights : (N,) float64, checked (no NaN / +inf)
     Returns (num,) int64 ancestor indices (the deterministic copies first, sorted).
     """
     num = _check_num(num)
-    expected = num * np.asarray(weights, dtype=np.float64)
+    expected = num * normalised_weights(log_weights)
     copies = np.floor(expected).astype(np.int64)
     indices = np.repeat(np.arange(expected.size), copies)
     rest = num - indices.size
     if rest == 0:
         return indices
-    leftover = expected - copies
-    return np.concatenate([indices, multinomial(leftover / leftover.sum(), rest, rng)])
+    with np.errstate(divide="ignore"):
+        leftover = np.log(expected - copies)
+    return np.concatenate([indices, multinomial(leftover, rest, rng)])
 
 
-#: Resampling schemes by name: ``f(weights (N,) summing to 1, num, rng) -> (num,) int64 indices``.
+#: Resampling schemes by name: ``f(log_weights (N,), num, rng) -> (num,) int64 ancestor indices``.
 RESAMPLING: dict[str, Callable[[np.ndarray, int, np.random.Generator], np.ndarray]] = {
     "multinomial": multinomial, "systematic": systematic, "stratified": stratified, "residual": residual,
 }
@@ -119,7 +127,7 @@ def check_scheme(scheme: str) -> str:
 def resample(log_weights, rng: np.random.Generator, scheme: str = "systematic", num: int | None = None) -> np.ndarray:
     """Ancestor indices drawn from log-weights with the scheme registered as ``scheme``.
 
-    log_weights : (N,) float, natural log, any additive constant; -inf = weight 0
+    log_weights : (N,) float, natural log, any additive constant; -inf = weight 0 (all -inf: equal)
     rng : np.random.Generator
     scheme : a key of RESAMPLING
     num : number of draws (default N)
@@ -128,5 +136,5 @@ def resample(log_weights, rng: np.random.Generator, scheme: str = "systematic", 
     check_scheme(scheme)
     if not isinstance(rng, np.random.Generator):
         raise ValueError(f"rng must be a np.random.Generator, got {type(rng).__name__}")
-    weights = normalised_weights(log_weights)
-    return RESAMPLING[scheme](weights, weights.size if num is None else num, rng)
+    log_weights = _checked(log_weights)
+    return RESAMPLING[scheme](log_weights, log_weights.size if num is None else num, rng)
