@@ -228,7 +228,7 @@ def test_look_at_rejects_degenerate_input():
 def test_presets_carry_the_documented_sensor_values():
     assert sorted(CAMERA_PRESETS) == ["azure_nfov", "kinect_v1", "kinect_v2", "realsense_d435"]
     assert CAMERA_PRESETS["kinect_v1"] == SensorSpec(
-        "kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.8, 4.0, "structured_light")
+        "kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.5, 4.5, "structured_light")
     assert CAMERA_PRESETS["kinect_v2"] == SensorSpec("kinect_v2", 512, 424, 365.5, 365.5, 254.9, 205.4, 0.5, 4.5, "tof")
     assert CAMERA_PRESETS["realsense_d435"] == SensorSpec(
         "realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "structured_light")

@@ -83,3 +83,41 @@ def test_score_without_groundtruth_is_a_clear_error(tmp_path, recording):
     (copy / "groundtruth.csv").unlink()
     result = CliRunner().invoke(main, ["score", str(copy), str(tmp_path / "t.csv")])
     assert result.exit_code != 0 and "no groundtruth.csv" in result.output
+
+
+def test_force_replaces_only_recordings_and_validates_first(tmp_path, recording):
+    runner = CliRunner()
+    keep = tmp_path / "keep"
+    keep.mkdir()
+    (keep / "notes.txt").write_text("precious")
+    result = runner.invoke(main, ["synth", "dance", str(keep), "--force"])
+    assert result.exit_code != 0 and "unknown scenario" in result.output
+    result = runner.invoke(main, ["synth", "no_occlusion", str(keep), "--frames", "2", "--force"])
+    assert result.exit_code != 0 and "is not a recording folder" in result.output
+    assert (keep / "notes.txt").read_text() == "precious"
+    afile = tmp_path / "a.txt"
+    afile.write_text("x")
+    result = runner.invoke(main, ["synth", "no_occlusion", str(afile), "--frames", "2"])
+    assert result.exit_code != 0 and "exists and is not a folder" in result.output
+    old = tmp_path / "old"
+    assert runner.invoke(main, ["synth", "no_occlusion", str(old), "--frames", "2", "--procedural"]).exit_code == 0
+    result = runner.invoke(main, ["synth", "no_occlusion", str(old), "--frames", "3", "--procedural", "--force"])
+    assert result.exit_code == 0 and Recording(old).num_frames == 3
+
+
+def test_show_and_score_on_a_folder_that_is_not_a_recording(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (tmp_path / "t.csv").write_text("frame,track,joint,x,y,z,visible\n")
+    for args in (["show", str(empty), "--out", str(tmp_path / "x.png")], ["score", str(empty), str(tmp_path / "t.csv")]):
+        result = CliRunner().invoke(main, args)
+        assert result.exit_code != 0 and "recording.json" in result.output and "Traceback" not in result.output
+
+
+def test_demo_pictures_the_last_frame_with_someone_in_view(tmp_path):
+    result = CliRunner().invoke(main, ["demo", "--out", str(tmp_path), "--frames", "60"])
+    assert result.exit_code == 0, result.output
+    assert "1 person(s) in view" in result.output
+    assert list(tmp_path.glob("sit_behind_table_frame0059.png"))
+    result = CliRunner().invoke(main, ["demo", "--out", str(tmp_path / "early"), "--frames", "10"])
+    assert result.exit_code == 0 and "nobody is in view in the first 10 frames" in result.output

@@ -7,6 +7,7 @@ import pytest
 
 from occupose.joints import UPPER_JOINTS
 from occupose.metrics import (
+    MISSED_ERROR_M,
     TableRow,
     fail_curve,
     foreground_scores,
@@ -159,16 +160,27 @@ def test_sustained_error_fails():
     assert not is_fail(errors, 10.0, threshold_m=0.30)
 
 
-def test_high_error_only_in_first_second_does_not_fail():
+def test_grace_period_then_windows_include_the_first_second():
     errors = np.full(60, 0.05)
-    errors[:10] = 2.0
-    assert not is_fail(errors, 10.0)
+    errors[:5] = 0.40  # a slow start: 0.5 s at 40 cm
     curve = fail_curve(errors, 10.0)
-    assert np.all(np.isnan(curve[:10]))
-    np.testing.assert_allclose(curve[10:], 0.05)
-    errors[10] = 2.0  # t = 1.0 s is judged
+    assert np.all(np.isnan(curve[:10]))  # nothing judged before t = 1 s
+    assert curve[10] == pytest.approx((5 * 0.40 + 6 * 0.05) / 11)  # but the window reaches back
+    assert not is_fail(errors, 10.0)
+    errors[:10] = 2.0  # wrong for the whole first second: the first judged window FAILs
     assert is_fail(errors, 10.0)
-    assert not is_fail(errors, 10.0, after_s=1.1)
+    errors = np.full(60, 0.05)
+    errors[10] = 0.30  # one bad frame at t = 1.0 s is averaged, not judged alone
+    assert not is_fail(errors, 10.0)
+
+
+def test_grace_period_starts_at_the_first_counted_frame():
+    errors = np.full(60, np.nan)
+    errors[30:] = 0.05
+    errors[30:35] = 2.0  # a person who walks in at 3 s, tracked badly at first
+    curve = fail_curve(errors, 10.0)
+    assert np.all(np.isnan(curve[:40])) and np.isfinite(curve[40])
+    assert is_fail(errors, 10.0) == (curve[40] > 0.25)
 
 
 def test_fail_threshold_is_strict():
@@ -176,14 +188,14 @@ def test_fail_threshold_is_strict():
     assert is_fail(np.full(60, np.nextafter(0.25, 1.0)), 10.0)
 
 
-def test_missed_frames_fail_after_the_grace_period_only():
+def test_missed_frames_count_as_one_metre_in_the_window():
     errors = np.full(60, 0.05)
     missed = np.zeros(60, dtype=bool)
-    errors[3], missed[3] = np.nan, True
+    errors[45], missed[45] = np.nan, True  # one dropped frame does not FAIL
     assert not is_fail(errors, 10.0, missed=missed)
-    errors[45], missed[45] = np.nan, True
+    assert fail_curve(errors, 10.0, missed=missed)[45] == pytest.approx((19 * 0.05 + MISSED_ERROR_M) / 20)
+    errors[40:], missed[40:] = np.nan, True  # a person lost for good does
     assert is_fail(errors, 10.0, missed=missed)
-    assert np.all(np.isinf(fail_curve(errors, 10.0, missed=missed)[45:60]))
     assert table_row(errors, 10.0, missed=missed).fail
 
 
@@ -410,3 +422,22 @@ def test_write_tracks_csv_checks_input(tmp_path):
         write_tracks_csv(tmp_path / "t.csv", {"a": (joints, visible)})
     with pytest.raises(ValueError, match="shape"):
         write_tracks_csv(tmp_path / "t.csv", {1: (joints[:, :9], visible)})
+
+
+def test_a_track_present_in_one_frame_does_not_steal_the_match():
+    gt = np.zeros((300, 1, 15, 3))
+    steady = gt[:, 0] + [0.10, 0.0, 0.0]  # 10 cm off, every frame
+    stray = np.full((300, 15, 3), np.nan)
+    stray[7] = gt[7, 0] + [0.01, 0.0, 0.0]  # 1 cm off, one frame
+    assert match_tracks(gt, {"steady": steady, "stray": stray}) == {"steady": 0}
+
+
+def test_frames_before_anything_of_the_person_is_visible_are_not_scored():
+    gt = np.zeros((90, 1, 15, 3))
+    visible = np.ones((90, 1, 15), bool)
+    visible[:30] = False  # walking in: in the image, but no joint visible yet
+    track = gt[:, 0].copy()
+    track[:33] = np.nan  # the tracker starts 3 frames after the first visible joint
+    person = score(gt, visible, {1: track}, fps=30.0).persons[0]
+    assert person.all_joints.frames == 60 and person.all_joints.coverage == pytest.approx(95.0)
+    assert not person.all_joints.fail and person.all_joints.mean_cm == 0.0

@@ -369,11 +369,12 @@ class SensorSpec:
 #: unbinned from the real factory calibration in ../shared/data/sensors/azure_kinect
 #: (normalised cx, cy, fx, fy of the 1024 x 1024 depth sensor, cropped to 640 x 576; the
 #: nominal 75 x 65 degree field of view includes lens distortion a pinhole cannot carry).
-#: Ranges from the makers' specs.
+#: Ranges from the makers' specs (Kinect v1: the raw stream's practical 0.5-4.5 m, wider
+#: than the 0.8-4.0 m its Windows SDK reports by default).
 CAMERA_PRESETS: dict[str, SensorSpec] = {
     spec.name: spec
     for spec in (
-        SensorSpec("kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.8, 4.0, "structured_light"),
+        SensorSpec("kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.5, 4.5, "structured_light"),
         SensorSpec("kinect_v2", 512, 424, 365.5, 365.5, 254.9, 205.4, 0.5, 4.5, "tof"),
         SensorSpec("azure_nfov", 640, 576, 504.61, 504.73, 332.78, 304.83, 0.5, 3.86, "tof"),
         SensorSpec("realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "structured_light"),

@@ -16,7 +16,23 @@ def _fail(message: str) -> None:
 def _progress_bar(total: int, desc: str):
     from tqdm import tqdm
 
-    return tqdm(total=total, desc=desc, unit="frame", dynamic_ncols=True)
+    return tqdm(total=total, desc=desc, unit="frame", dynamic_ncols=True, mininterval=1.0)
+
+
+def _clear_output(out: Path, force: bool) -> None:
+    """Make ``out`` ready for a new recording: it must not exist, be empty, or (with
+    ``force``) be an earlier recording, which is removed. Anything else is refused."""
+    if not out.exists():
+        return
+    if not out.is_dir():
+        _fail(f"{out} exists and is not a folder")
+    if not any(out.iterdir()):
+        return
+    if not force:
+        _fail(f"{out} exists and is not empty (use --force to replace an earlier recording)")
+    if not (out / "recording.json").is_file():
+        _fail(f"{out} is not a recording folder (no recording.json): not removing it, even with --force")
+    shutil.rmtree(out)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -40,10 +56,6 @@ def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: st
     from occupose.synth.generate import write_scenario
     from occupose.synth.scenarios import build_scenario
 
-    if out.exists() and any(out.iterdir()):
-        if not force:
-            _fail(f"{out} exists and is not empty (use --force to replace it)")
-        shutil.rmtree(out)
     try:
         scenario = build_scenario(name, seed=seed, sensor=sensor, use_mocap=not procedural)
     except ValueError as error:
@@ -51,6 +63,7 @@ def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: st
     total = scenario.num_frames if frames is None else frames
     if not 0 < total <= scenario.num_frames:
         _fail(f"--frames must be in 1..{scenario.num_frames} for {name}, got {frames}")
+    _clear_output(out, force)
     with _progress_bar(total, f"rendering {name}") as bar:
         write_scenario(scenario, out, seed=seed, num_frames=total, progress=bar.update)
     click.echo(f"wrote {out} ({total} frames, {len(scenario.cameras)} camera(s), "
@@ -61,8 +74,9 @@ def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: st
 @main.command("synth")
 @click.argument("name")
 @click.argument("out", type=click.Path(path_type=Path))
-@click.option("--seed", default=0, show_default=True, help="Seed of the scene's randomness and sensor noise.")
-@click.option("--frames", type=int, default=None, help="Render only the first N frames.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the scene's randomness and sensor noise.")
+@click.option("--frames", type=click.IntRange(min=1), default=None, help="Render only the first N frames.")
 @click.option("--sensor", default=None, help="Camera model for every camera (kinect_v1, kinect_v2, azure_nfov, realsense_d435).")
 @click.option("--procedural", is_flag=True, help="Use the built-in procedural motion even when real mocap clips are present.")
 @click.option("--force", is_flag=True, help="Replace OUT if it exists.")
@@ -73,7 +87,7 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
 
 @main.command("show")
 @click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
-@click.option("--frame", "index", type=int, default=0, show_default=True)
+@click.option("--frame", "index", type=click.IntRange(min=0), default=0, show_default=True)
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="PNG file to write.")
 @click.option("--tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="A tracks.csv to draw beside the ground truth.")
@@ -87,7 +101,7 @@ def show_cmd(recording, index, out, tracks) -> None:
         rec = Recording(recording)
         track_data = read_tracks_csv(tracks, rec.num_frames) if tracks else None
         path = show_frame(rec, index, out, track_data)
-    except ValueError as error:
+    except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
     click.echo(f"wrote {path}")
 
@@ -101,7 +115,7 @@ def score_cmd(recording, tracks) -> None:
 
     try:
         click.echo(score_text(Recording(recording), tracks))
-    except ValueError as error:
+    except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
 
 
@@ -128,7 +142,7 @@ def score_text(rec, tracks_path: Path) -> str:
 @main.command("demo")
 @click.option("--out", type=click.Path(path_type=Path), default=Path("demo-output"), show_default=True)
 @click.option("--scenario", default="sit_behind_table", show_default=True)
-@click.option("--frames", type=int, default=300, show_default=True)
+@click.option("--frames", type=click.IntRange(min=1), default=300, show_default=True)
 def demo_cmd(out, scenario, frames) -> None:
     """Render a built-in scenario with procedural motion (no shared data needed) and picture it."""
     from occupose.recording import Recording
@@ -138,10 +152,15 @@ def demo_cmd(out, scenario, frames) -> None:
                             procedural=True)
     rec = Recording(rec_path)
     gt = rec.groundtruth()
+    present = np.flatnonzero(np.isfinite(gt.joints[..., 0, 0]).any(axis=1))
+    if present.size == 0:
+        click.echo(f"nobody is in view in the first {frames} frames: render more with --frames")
+        return
     hidden = 100.0 * (1 - gt.visible[np.isfinite(gt.joints[..., 0])].mean())
-    index = frames - 1
+    index = int(present[-1])
     picture = show_frame(rec, index, out / f"{scenario}_frame{index:04d}.png")
-    click.echo(f"ground truth: {gt.joints.shape[1]} person(s), {hidden:.1f} % of joint observations hidden")
+    click.echo(f"ground truth: {len(gt.person_ids)} person(s) in view, {hidden:.1f} % of their joint "
+               "observations hidden (furniture, other people, their own body, image border)")
     click.echo(f"picture: {picture}")
     click.echo("the tracker is not built yet: score any tracks.csv with "
                f"`occupose score {rec_path} TRACKS.csv`")

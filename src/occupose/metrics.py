@@ -11,9 +11,11 @@ frame error ``D_t``
     Mean of the joint errors of frame ``t`` over the joints that count (finite error,
     and inside the optional mask, e.g. ground-truth-visible joints only).
 counted, estimated, missed and excluded frames
-    A frame counts for a person when ground truth has the person. A counted frame is
+    A frame counts for a person when ground truth has the person and at least one of
+    their joints is visible to a camera (`score`; a person walking in, or fully behind
+    a cabinet, is not scored until something of them can be seen). A counted frame is
     *estimated* when ``D_t`` is finite and *missed* when the tracker has no estimate of
-    the person. Frames where ground truth has no person are excluded from everything.
+    the person. Other frames are excluded from everything.
 table row (Table I)
     ``mean`` and population ``std`` of ``D_t`` over the estimated frames (the paper's
     formula, ``1/T``); percentages over all counted frames of ``D_t <= 10, 15, 20 cm``
@@ -24,20 +26,18 @@ table row (Table I)
     that are estimated.
 FAIL
     The rolling mean of ``D_t`` over a trailing window of ``window_s`` seconds
-    (``round(window_s * fps)`` frames, the current frame included) exceeds
-    ``threshold_m`` (strictly) at some frame of time ``t = index / fps >= after_s``.
-    The first ``after_s`` seconds are a grace period for initialisation: their frames
-    enter no window, so nothing that happens in them (large errors, missed frames) can
-    FAIL a sequence. A window that reaches back before the end of the grace period (or
-    before the start of the sequence) averages the judged frames it holds, so the first
-    windows after the grace period hold fewer frames than later ones. Excluded frames
-    are skipped inside a window; a missed frame counts as an infinite error, so a person
-    lost after the grace period always FAILs.
+    (``round(window_s * fps)`` frames, the current frame included; windows reaching
+    before the first frame average the frames they hold) exceeds ``threshold_m``
+    (strictly) at some frame at least ``after_s`` seconds after the person's first
+    counted frame: a grace period for the tracker to start. Excluded frames are skipped
+    inside a window; a missed frame counts as an error of ``MISSED_ERROR_M`` (1 m), so
+    a person lost for good FAILs while a single dropped frame does not.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +48,12 @@ from numpy.lib.stride_tricks import sliding_window_view
 from scipy.optimize import linear_sum_assignment
 
 from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS
+
+#: Error a missed frame counts as in the FAIL rule's rolling mean, metres.
+MISSED_ERROR_M = 1.0
+#: Cost of a frame where a person has ground truth and a track has no estimate, when
+#: matching tracks to people (metres, as a mean joint distance).
+ABSENT_COST_M = 0.5
 
 #: Upper bounds of the "under" columns of Table I, metres (a frame counts when D_t <= bound).
 UNDER_BOUNDS_M: tuple[float, ...] = (0.10, 0.15, 0.20)
@@ -265,23 +271,22 @@ def fail_curve(
         Frames per second; frame ``i`` is at ``i / fps`` seconds.
     missed : (T,) bool, optional
         Frames where ground truth has the person and the tracker has no estimate
-        (their ``frame_errors`` must be NaN); they count as infinite error.
+        (their ``frame_errors`` must be NaN); they count as ``MISSED_ERROR_M``.
     window_s, after_s : float
-        Window duration and grace period, seconds.
+        Window duration and grace period after the first counted frame, seconds.
 
     Returns
     -------
-    (T,) float64, metres: NaN during the grace period and where a window holds no
-    counted frame, +inf where it holds a missed frame.
+    (T,) float64, metres: NaN before the end of the grace period and where a window
+    holds no counted frame.
     """
     values = _frame_values(frame_errors, missed)
     fps = _positive_float(fps, "fps")
     after_s = _nonnegative_float(after_s, "after_s")
-    first = int(math.ceil(after_s * fps - 1e-9))
-    judged = values.copy()
-    judged[:first] = np.nan
-    curve = rolling_mean(judged, fps, window_s=window_s)
-    curve[:first] = np.nan
+    counted = np.flatnonzero(~np.isnan(values))
+    curve = rolling_mean(np.where(np.isinf(values), MISSED_ERROR_M, values), fps, window_s=window_s)
+    start = counted[0] + int(math.ceil(after_s * fps - 1e-9)) if counted.size else values.size
+    curve[:start] = np.nan
     return curve
 
 
@@ -530,15 +535,25 @@ def match_tracks(gt: Any, tracks: Mapping[Any, Any]) -> dict[Any, int]:
 
     Returns
     -------
-    ``{track_id: person index}``. The assignment minimises the summed cost, where the
-    cost of a pair is the mean, over the frames where both have a joint in common, of
-    the mean joint distance (`scipy.optimize.linear_sum_assignment`). A pair with no
-    such frame cannot be matched; a track left over (more tracks than people, or no
-    overlap) is unmatched and absent from the result.
+    ``{track_id: person index}``. The assignment minimises the summed cost
+    (`scipy.optimize.linear_sum_assignment`); the cost of a pair is the mean over the
+    person's frames of the mean joint distance where both have a joint in common, and
+    ``ABSENT_COST_M`` where the person has ground truth and the track has none (so a
+    track present in one frame does not beat one that follows the person throughout).
+    A pair with no frame in common cannot be matched; a track left over (more tracks
+    than people, or no overlap) is unmatched and absent from the result.
     """
     gt = _check_people(gt)
     tracks = _check_tracks(tracks, gt.shape[0], gt.shape[2])
-    cost = _nanmean(_pair_distances(gt, tracks), axis=0)  # (P, K)
+    distances = _pair_distances(gt, tracks)  # (T, P, K)
+    person_frames = np.any(np.all(np.isfinite(gt), axis=3), axis=2)  # (T, P)
+    track_frames = np.stack([np.any(np.all(np.isfinite(t), axis=2), axis=1) for t in tracks.values()], axis=1) \
+        if tracks else np.zeros((gt.shape[0], 0), bool)  # (T, K)
+    absent = person_frames[:, :, None] & ~track_frames[:, None, :]
+    overlap = np.isfinite(distances)
+    total = np.where(overlap, distances, 0.0).sum(axis=0) + ABSENT_COST_M * absent.sum(axis=0)
+    frames = (overlap | absent).sum(axis=0)
+    cost = np.where(overlap.any(axis=0), total / np.maximum(frames, 1), np.nan)  # (P, K)
     ids = list(tracks)
     return {ids[k]: p for p, k in _assign(cost)}
 
@@ -625,8 +640,9 @@ def score(
     Tracks are matched to people with `match_tracks`. For each person, the evaluated
     joints are those the matched track reports in at least one frame (the upper-body
     model reports 9 of the 15); the other joints are left out of both sides. A frame
-    counts when ground truth has at least one evaluated joint (for the visible-only row:
-    at least one visible evaluated joint), and is missed when the track has no
+    counts when ground truth has at least one evaluated joint and at least one of the
+    person's joints is visible (for the visible-only row: at least one visible evaluated
+    joint), and is missed when the track has no
     evaluated joint in it (a frame where both have joints but none in common has no
     error and is left out). A person without a track is missed in every counted frame
     (evaluated joints: all 15).
@@ -665,7 +681,8 @@ def score(
         gt = gt_joints[:, person, evaluated]
         est = est[:, evaluated]
         visible = gt_visible[:, person, evaluated]
-        gt_known = np.all(np.isfinite(gt), axis=2)
+        in_sight = np.any(gt_visible[:, person], axis=1)[:, None]
+        gt_known = np.all(np.isfinite(gt), axis=2) & in_sight
         has_estimate = np.any(np.all(np.isfinite(est), axis=2), axis=1)
         errors = joint_errors(gt, est)
         rows = []
@@ -775,44 +792,47 @@ def read_tracks_csv(path: str | Path, num_frames: int) -> dict[int, tuple[np.nda
         raise FileNotFoundError(f"tracks file not found: {path}")
     columns: dict[int, tuple[list[int], list[int], list[list[float]], list[bool]]] = {}
     seen: set[tuple[int, int, int]] = set()
-    with path.open(newline="") as handle:
-        reader = csv.reader(handle)
-        header = next(reader, None)
-        if header is None or tuple(cell.strip() for cell in header) != TRACKS_CSV_HEADER:
-            raise ValueError(
-                f"{path}: expected header {','.join(TRACKS_CSV_HEADER)!r}, got "
-                f"{'an empty file' if header is None else repr(','.join(header))}"
-            )
-        for cells in reader:
-            if not cells:
-                continue
-            where = (path, reader.line_num)
-            if len(cells) != len(TRACKS_CSV_HEADER):
-                raise _csv_error(where, f"expected {len(TRACKS_CSV_HEADER)} columns, got {len(cells)}")
-            frame = _parse_int(cells[0], "frame", where)
-            track = _parse_int(cells[1], "track", where)
-            name = cells[2].strip()
-            joint = JOINT_INDEX.get(name)
-            if joint is None:
-                raise _csv_error(where, f"unknown joint {name!r} (valid: {', '.join(JOINTS)})")
-            position = [_parse_float(cells[3], "x", where), _parse_float(cells[4], "y", where),
-                        _parse_float(cells[5], "z", where)]
-            visible = cells[6].strip()
-            if visible not in ("0", "1"):
-                raise _csv_error(where, f"visible must be 0 or 1, got {visible!r}")
-            if not 0 <= frame < num_frames:
-                raise _csv_error(where, f"frame {frame} outside 0..{num_frames - 1}")
-            key = (frame, track, joint)
-            if key in seen:
-                raise _csv_error(where, f"repeated row for frame {frame}, track {track}, joint {name}")
-            seen.add(key)
-            if track not in columns:
-                columns[track] = ([], [], [], [])
-            frames, joints, positions, flags = columns[track]
-            frames.append(frame)
-            joints.append(joint)
-            positions.append(position)
-            flags.append(visible == "1")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path}: not a UTF-8 text file ({error.reason} at byte {error.start})") from None
+    reader = csv.reader(io.StringIO(text, newline=""))
+    header = next(reader, None)
+    if header is None or tuple(cell.strip() for cell in header) != TRACKS_CSV_HEADER:
+        raise ValueError(
+            f"{path}: expected header {','.join(TRACKS_CSV_HEADER)!r}, got "
+            f"{'an empty file' if header is None else repr(','.join(header))}"
+        )
+    for cells in reader:
+        if not cells:
+            continue
+        where = (path, reader.line_num)
+        if len(cells) != len(TRACKS_CSV_HEADER):
+            raise _csv_error(where, f"expected {len(TRACKS_CSV_HEADER)} columns, got {len(cells)}")
+        frame = _parse_int(cells[0], "frame", where)
+        track = _parse_int(cells[1], "track", where)
+        name = cells[2].strip()
+        joint = JOINT_INDEX.get(name)
+        if joint is None:
+            raise _csv_error(where, f"unknown joint {name!r} (valid: {', '.join(JOINTS)})")
+        position = [_parse_float(cells[3], "x", where), _parse_float(cells[4], "y", where),
+                    _parse_float(cells[5], "z", where)]
+        visible = cells[6].strip()
+        if visible not in ("0", "1"):
+            raise _csv_error(where, f"visible must be 0 or 1, got {visible!r}")
+        if not 0 <= frame < num_frames:
+            raise _csv_error(where, f"frame {frame} outside 0..{num_frames - 1}")
+        key = (frame, track, joint)
+        if key in seen:
+            raise _csv_error(where, f"repeated row for frame {frame}, track {track}, joint {name}")
+        seen.add(key)
+        if track not in columns:
+            columns[track] = ([], [], [], [])
+        frames, joints, positions, flags = columns[track]
+        frames.append(frame)
+        joints.append(joint)
+        positions.append(position)
+        flags.append(visible == "1")
     tracks = {}
     for track, (frames, joints, positions, flags) in columns.items():
         points = np.full((num_frames, NUM_JOINTS, 3), np.nan)
@@ -877,7 +897,7 @@ def write_tracks_csv(path: str | Path, tracks: Mapping[int, tuple[Any, Any]]) ->
         num_frames = joints.shape[0]
         checked.append((int(track_id), joints, visible))
     checked.sort(key=lambda item: item[0])
-    with Path(path).open("w", newline="") as handle:
+    with Path(path).open("w", newline="", encoding="utf-8") as handle:
         handle.write(",".join(TRACKS_CSV_HEADER) + "\n")
         for frame in range(num_frames or 0):
             lines = [

@@ -11,16 +11,19 @@ from occupose.joints import BONES
 from occupose.recording import Recording
 
 
-def _figure(width: int, height: int, panels: int):
+def _depth_colors():
     import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    return matplotlib.colormaps["turbo"].with_extremes(bad="black")
+
+
+def _figure(width: int, height: int, panels: int):
+    """A matplotlib Figure (no pyplot, so no global backend state) with ``panels`` axes."""
+    from matplotlib.figure import Figure
 
     scale = 6.0 / width
-    fig, axes = plt.subplots(1, panels, figsize=(panels * width * scale, height * scale + 0.5),
-                             squeeze=False)
-    return fig, axes[0]
+    fig = Figure(figsize=(panels * width * scale, height * scale + 0.5))
+    return fig, fig.subplots(1, panels, squeeze=False)[0]
 
 
 def draw_skeleton(ax, uv: np.ndarray, visible: np.ndarray, color: str, label: str | None = None) -> None:
@@ -42,7 +45,8 @@ def draw_skeleton(ax, uv: np.ndarray, visible: np.ndarray, color: str, label: st
 def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict | None = None) -> Path:
     """Write a PNG of frame ``index``: for every camera, the depth image colour-mapped
     (black = no measurement) with the ground-truth skeletons over it (hidden joints as
-    crosses, bones to them dashed) and, when given, tracked skeletons.
+    crosses, bones to them dashed; ``visible`` is the ground truth's flag, i.e. seen by
+    *some* camera, so with several cameras a joint drawn visible may be hidden in this one) and, when given, tracked skeletons.
 
     tracks : optional {track id: (joints (T, 15, 3), visible (T, 15))} as read from a tracks.csv.
     """
@@ -55,8 +59,7 @@ def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict |
     colors = ["#ff2bd6", "#ffffff", "#7dff6a", "#ffd23f"]
     for ax, cam in zip(axes, cams):
         depth = np.where(frame.depth[cam.name] > 0, frame.depth[cam.name], np.nan)
-        im = ax.imshow(depth, cmap="turbo", vmin=0.5, vmax=max(4.5, float(np.nanmax(depth)) if np.any(depth > 0) else 4.5))
-        ax.set_facecolor("black")
+        im = ax.imshow(depth, cmap=_depth_colors(), vmin=0.5, vmax=max(4.5, float(np.nanmax(depth)) if np.any(depth > 0) else 4.5))
         ax.set_title(f"{recording.path.name} — {cam.name} — frame {index}", fontsize=8)
         ax.set_xlim(0, cam.width)
         ax.set_ylim(cam.height, 0)
@@ -81,7 +84,4 @@ def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict |
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110, bbox_inches="tight")
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
     return out

@@ -101,7 +101,6 @@ def _frame(forward_hint: np.ndarray, up: np.ndarray) -> np.ndarray:
     up = _unit(up, np.array([0.0, 0.0, 1.0]))
     fwd = forward_hint - up * (forward_hint @ up)
     fwd = _unit(fwd, np.cross(up, [1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.cross(up, [0.0, 1.0, 0.0]))
-    fwd = _unit(fwd, fwd)
     left = np.cross(up, fwd)
     return np.column_stack([left, fwd, up])
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from occupose.camera import pixels_from_points
+from occupose.camera import pixels_from_points, raw_depth_from_metres
 from occupose.joints import JOINT_PART, PARTS
 from occupose.recording import RecordingWriter
 from occupose.synth.body import primitives_from_joints
@@ -95,7 +95,8 @@ def frames(scenario: Scenario, seed: int = 0, num_frames: int | None = None,
             bg = static_bg[cam.name] if len(moving) == 0 else render_camera(moving, cam, background=static_bg[cam.name])
             full = render_camera(concat(bodies), cam, background=bg)
             rendered[cam.name] = full
-            depth[cam.name] = apply_noise(full.depth, scenario.noise[cam.name], rng, fx=cam.fx)
+            model, options = scenario.noise[cam.name]
+            depth[cam.name] = apply_noise(full.depth, model, rng, fx=cam.fx, **options)
             for i, body in enumerate(bodies):
                 alone = _alone_counts(body, cam)
                 seen = _part_counts(full, i + 1)
@@ -122,9 +123,8 @@ def write_scenario(scenario: Scenario, out: str | Path, seed: int = 0, num_frame
     vis = np.zeros((total, num_people, 15), bool)
     with RecordingWriter(out, list(scenario.cameras), scenario.fps) as writer:
         for frame in frames(scenario, seed, total):
-            scale = {c.name: c.depth_scale for c in scenario.cameras}
             writer.write_frame(
-                {name: np.round(d / scale[name]).astype(np.uint16) for name, d in frame.depth.items()},
+                {cam.name: raw_depth_from_metres(frame.depth[cam.name], cam) for cam in scenario.cameras},
                 {name: r.color for name, r in frame.rendered.items()},
                 labels={name: {"person": r.person.astype(np.uint8), "part": r.part}
                         for name, r in frame.rendered.items()},

@@ -12,7 +12,7 @@ otherwise, and always for what the clips lack (sitting, carrying a chair, walks 
 end at an exact spot). ``Scenario.motion_source`` says which was used.
 
 World frame: metres, z up, floor at z = 0. Front-view scenes look from y = 0 towards +y
-into a 6 m wide room whose back wall stands at y = 4.5 (inside a Kinect's range).
+into a 6 m wide room whose back wall stands at y = 4.2 (inside a Kinect v1's range).
 """
 
 from __future__ import annotations
@@ -25,12 +25,12 @@ import numpy as np
 
 from occupose.camera import Camera, camera_preset, look_at, sensor_spec
 from occupose.joints import JOINT_INDEX as J
-from occupose.mocap import canonical_from_clip, find_clip, load_clip, place, resample
+from occupose.mocap import canonical_from_clip, facing_from_joints as facing, find_clip, load_clip, place, resample
 from occupose.synth import motion as pm
 from occupose.synth.body import BodyShape, random_body_shape
 from occupose.synth.primitives import Primitives, concat
 from occupose.synth.scene import chair, cabinet, couch, room, table
-from occupose.synth.sequence import chain, facing
+from occupose.synth.sequence import chain
 
 FPS = 30.0
 FACING_CAMERA = -math.pi / 2  # front-view cameras look along +y; a person facing them faces -y
@@ -48,7 +48,8 @@ class Person:
 class Scenario:
     """A scene ready to render.
 
-    cameras : the depth cameras; noise : camera name -> sensor noise model name
+    cameras : the depth cameras; noise : camera name -> (noise model name, its options:
+        the sensor's measuring range)
     static : furniture and room that never move; moving : per frame, furniture that moves
         (empty batches where nothing moves), or None
     events : named frame intervals [start, stop) worth knowing (e.g. "sitting")
@@ -58,7 +59,7 @@ class Scenario:
     description: str
     fps: float
     cameras: tuple[Camera, ...]
-    noise: dict[str, str]
+    noise: dict[str, tuple[str, dict]]
     static: Primitives
     people: tuple[Person, ...]
     motion_source: str
@@ -169,8 +170,9 @@ def _cameras(sensor: str | None, specs) -> tuple[tuple[Camera, ...], dict[str, s
     cams, noise = [], {}
     for name, default, eye, target in specs:
         preset = sensor or default
+        spec = sensor_spec(preset)
         cams.append(camera_preset(preset, world_from_camera=look_at(eye, target), camera_name=name))
-        noise[name] = sensor_spec(preset).noise
+        noise[name] = (spec.noise, {"min_range": spec.near, "max_range": spec.far})
     return tuple(cams), noise
 
 
@@ -183,7 +185,8 @@ def _top(sensor: str | None):
 
 
 def _front_room() -> Primitives:
-    return room(width=6.0, depth=5.0, height=2.8, center_xy=(0.0, 2.0), walls=("+x", "-x", "+y"))
+    return room(width=6.0, depth=4.7, height=2.8, center_xy=(0.0, 1.85), walls=("+x", "-x", "+y", "-y"),
+                ceiling=True)
 
 
 def _shop_room() -> Primitives:
@@ -215,7 +218,7 @@ def _sit_frames(segments, name):
     return found[0].start, found[-1].stop
 
 
-def _sit_behind_table_parts(rng, use_mocap, sensor):
+def _sit_behind_table_parts(rng, use_mocap):
     furniture = concat([table((0.0, 2.5), heading=FACING_CAMERA, panel=True), couch((0.0, 3.6), heading=FACING_CAMERA)])
     dims = _dims(rng)
     b = pm.MotionBuilder((2.9, 3.05), math.pi, dims, FPS)
@@ -229,7 +232,7 @@ def _sit_behind_table_parts(rng, use_mocap, sensor):
 
 
 def _sit_behind_table(rng, use_mocap, sensor):
-    furniture, m, events = _sit_behind_table_parts(rng, use_mocap, sensor)
+    furniture, m, events = _sit_behind_table_parts(rng, use_mocap)
     cams, noise = _front(sensor)
     return dict(cameras=cams, noise=noise, static=concat([_front_room(), furniture]),
                 people=(Person(m.joints(600), random_body_shape(rng)),), motion_source="procedural",
@@ -237,7 +240,7 @@ def _sit_behind_table(rng, use_mocap, sensor):
 
 
 def _two_cameras_occlusion(rng, use_mocap, sensor):
-    furniture, m, events = _sit_behind_table_parts(rng, use_mocap, sensor)
+    furniture, m, events = _sit_behind_table_parts(rng, use_mocap)
     cams, noise = _cameras(sensor, [("front", "kinect_v1", (0.0, 0.0, 1.6), (0.0, 3.0, 0.9)),
                                     ("side", "kinect_v2", (2.8, 2.2, 2.0), (0.0, 3.2, 0.7))])
     return dict(cameras=cams, noise=noise, static=concat([_front_room(), furniture]),

@@ -31,11 +31,15 @@ def _part(center_xy, heading, local_center, half, color) -> Primitives:
 
 
 def room(width: float = 6.0, depth: float = 6.0, height: float = 2.8,
-         center_xy=(0.0, 0.0), walls: tuple[str, ...] = ("+x", "-x", "+y", "-y")) -> Primitives:
-    """Floor (top face at z = 0) and the named walls of a ``width`` (x) by ``depth`` (y) room."""
+         center_xy=(0.0, 0.0), walls: tuple[str, ...] = ("+x", "-x", "+y", "-y"),
+         ceiling: bool = False) -> Primitives:
+    """Floor (top face at z = 0), the named walls and optionally the ceiling of a
+    ``width`` (x) by ``depth`` (y) room."""
     cx, cy = center_xy
     t = 0.05
     prims = [box((cx, cy, -t), (width / 2 + t, depth / 2 + t, t), FLOOR)]
+    if ceiling:
+        prims.append(box((cx, cy, height + t), (width / 2 + t, depth / 2 + t, t), WALL))
     spec = {
         "+x": ((cx + width / 2 + t, cy, height / 2), (t, depth / 2 + t, height / 2)),
         "-x": ((cx - width / 2 - t, cy, height / 2), (t, depth / 2 + t, height / 2)),

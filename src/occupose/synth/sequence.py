@@ -12,16 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from occupose.joints import JOINT_INDEX as J
-
-
-def facing(joints: np.ndarray) -> np.ndarray:
-    """Heading (rad about z, 0 = +x) a person faces: (left_hip - right_hip) x up.
-
-    joints : (..., 15, 3) metres. Returns (...,) radians.
-    """
-    lr = joints[..., J["left_hip"], :] - joints[..., J["right_hip"], :]
-    # (lx, ly, lz) x (0, 0, 1) = (ly, -lx, 0)
-    return np.arctan2(-lr[..., 0], lr[..., 1])
+from occupose.mocap import facing_from_joints as facing
 
 
 def rigid_z(joints: np.ndarray, angle: float, pivot_xy, to_xy) -> np.ndarray:
