@@ -133,6 +133,15 @@ def test_kernel_matches_numpy_reference(name, rng):
     assert np.isnan(joints[:, J["left_knee"]]).all() == (name == "upper")
 
 
+def test_kernel_sincos_matches_libm(rng):
+    from occupose.body._kernels import sincos
+
+    x = np.concatenate([rng.uniform(-60.0, 60.0, 3000), np.arange(-8, 9) * math.pi / 4, [0.0, -0.0]])
+    got = np.array([sincos(v) for v in x])
+    np.testing.assert_allclose(got[:, 0], np.sin(x), rtol=0, atol=3e-16)
+    np.testing.assert_allclose(got[:, 1], np.cos(x), rtol=0, atol=3e-16)
+
+
 def _pose(m, **values):
     pose = np.zeros(m.num_dofs)
     for key, value in values.items():
@@ -380,3 +389,4 @@ def test_root_drift():
     drift = root_drift(m, previous, current, damping=0.5)
     np.testing.assert_allclose(drift[:3], [0.02, -0.01, 0.0], atol=1e-12)
     assert not drift[3:].any()
+
