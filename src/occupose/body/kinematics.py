@@ -37,11 +37,8 @@ def capsules_from_poses(model: BodyModel, poses) -> tuple[np.ndarray, np.ndarray
     num = poses.shape[0]
     a = np.empty((num, model.num_capsules, 3))
     b = np.empty((num, model.num_capsules, 3))
-    _kernels.points_from_poses(poses, *_tree(model),
-                               np.ascontiguousarray(model.capsule_nodes[:, 0]),
-                               np.ascontiguousarray(model.capsule_offsets[:, 0]), a,
-                               np.ascontiguousarray(model.capsule_nodes[:, 1]),
-                               np.ascontiguousarray(model.capsule_offsets[:, 1]), b)
+    _kernels.points_from_poses(poses, *_tree(model), model.capsule_nodes[0], model.capsule_offsets[0], a,
+                               model.capsule_nodes[1], model.capsule_offsets[1], b)
     return a, b
 
 

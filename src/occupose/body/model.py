@@ -91,8 +91,8 @@ class BodyModel:
         dof_sign : (D,) float64, +1 or -1 (the DOF turns about sign * axis)
     part_names : (K,) str, the weighting / visibility parts
     capsule_part : (C,) int64; capsule_radii : (C, 2) float64 (ra, rb) metres
-    capsule_nodes : (C, 2) int64 and capsule_offsets : (C, 2, 3) metres, ends a and b of
-        each round cone as offsets in a node's frame
+    capsule_nodes : (2, C) int64 and capsule_offsets : (2, C, 3) metres: ends a ([0]) and
+        b ([1]) of each round cone as offsets in a node's frame
     joint_nodes : (15,) int64, the node at each canonical joint, -1 where the model does
         not report the joint; joint_offsets : (15, 3) offsets in those nodes' frames
     partitions : list of Partition in partitioned-sampling order (torso first, then down
@@ -212,8 +212,8 @@ class _Builder:
             part_names=part_names,
             capsule_part=frozen([part_names.index(c[0]) for c in self.capsules], np.int64),
             capsule_radii=frozen([(c[5], c[6]) for c in self.capsules], np.float64),
-            capsule_nodes=frozen([(c[1], c[3]) for c in self.capsules], np.int64),
-            capsule_offsets=frozen([(c[2], c[4]) for c in self.capsules], np.float64),
+            capsule_nodes=frozen([[c[1] for c in self.capsules], [c[3] for c in self.capsules]], np.int64),
+            capsule_offsets=frozen([[c[2] for c in self.capsules], [c[4] for c in self.capsules]], np.float64),
             joint_nodes=frozen(joint_nodes, np.int64),
             joint_offsets=frozen(joint_offsets, np.float64),
             partitions=groups(partitions), weight_groups=groups(weight_groups),
