@@ -12,23 +12,25 @@ end ``a`` (radius ra) to end ``b`` (radius rb), each end a fixed offset in a nod
 
 Two built-in models (:data:`BODY_MODELS`, :func:`body_model`):
 
-``full`` -- the first paper's 10-part, 25-DOF body (Fig. 6 of the occupancy-HMM paper):
-    ==  ==============================  ============================================
-    0   x, y, z                         pelvis (midpoint of the hips), world metres
-    3   heading, trunk_lean, trunk_side torso: turn about +z (0 = facing +x), lean
-                                        forward, lean to the left (Z-Y-X Euler angles)
-    6   neck_flex, neck_side, neck_twist head: nod forward, tilt left, turn left
-    9   left_shoulder_flex/abd/rot,     upper arm forward (pi/2 horizontal, pi up),
-        left_elbow                      then out to the side, then turned outwards;
-                                        elbow flexion (0 = straight)
-    13  right_... (mirror)
-    17  left_hip_flex/abd/rot,          thigh forward, out to the side, turned outwards;
-        left_knee                       knee flexion (0 = straight, the shin swings back)
-    21  right_... (mirror)
-    ==  ==============================  ============================================
+``full`` -- the first paper's 10-part, 25-DOF body (Fig. 6 of the occupancy-HMM paper).
+    DOFs in order (the index of the first of each group in brackets):
+
+    - [0] ``x, y, z``: the pelvis (midpoint of the hips), world metres;
+    - [3] ``heading, trunk_lean, trunk_side``: the torso turned about +z (0 = facing +x,
+      periodic), leaned forward, leaned to its left (Z-Y-X Euler angles);
+    - [6] ``neck_flex, neck_side, neck_twist``: the head nodded forward, tilted left, turned left;
+    - [9] ``left_shoulder_flex, _abd, _rot, left_elbow``: the upper arm forward (pi/2
+      horizontal, pi straight up), then out to the side, then turned outwards about its
+      axis; elbow flexion (0 = straight); [13] the same for the right arm (mirrored);
+    - [17] ``left_hip_flex, _abd, _rot, left_knee``: the thigh forward, out to the side,
+      turned outwards; knee flexion (0 = straight, the shin swings back); [21] right leg.
+
     Parts (one round cone each): torso, head, left_upper_arm, left_forearm (the hand
     included as a short extension past the wrist), right_upper_arm, right_forearm,
-    left_thigh, left_shin, right_thigh, right_shin.
+    left_thigh, left_shin, right_thigh, right_shin. Partitions: the root with the torso's
+    orientation (weighted by the torso and the upper arms and thighs, whose attachment
+    shows the heading that a round torso cannot), the head, the left arm, the right arm,
+    the left leg, the right leg.
 
 ``upper`` -- the second paper's 6-part, 17-DOF upper body (top view):
     x, y, z (pelvis), heading, trunk_lean (the bend at the pelvis), neck_flex, neck_side,
@@ -37,7 +39,9 @@ Two built-in models (:data:`BODY_MODELS`, :func:`body_model`):
     elliptic-cylinder torso as 3 parallel cones (left, centre, right), per arm an upper
     arm cone, a forearm cone and a flat hand of 2 thin parallel cones. Weighting parts and
     their DOFs are Table 1 of the paper: head (neck), shoulders (x, y, z), torso (heading,
-    trunk_lean), right_arm and left_arm (5 each).
+    trunk_lean), right_arm and left_arm (5 each). Partitions: the root with heading and
+    lean (weighted by the shoulders and the torso), the head, the left arm, the right arm.
+    (The paper's state vector lists the right arm first; both models here put left first.)
 
 Angle conventions equal :mod:`occupose.synth.motion` (same names), so a procedural pose's
 arm and leg angles carry over; the model's hips turn with the torso where the generator's
