@@ -28,11 +28,29 @@ import numpy as np
 UNOBSERVED = 0
 VISIBLE = 1
 HIDDEN = 2
+#: The observation function's Gaussian tails stop at this many tail widths.
+TAIL_CUT = 3.0
 
 
-@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+def observation(epsilon, half_extent, width, p_occ, p_free):
+    """The observation function f(epsilon) (see occupose.grid.occupancy.observation_function)."""
+    if epsilon > half_extent:
+        excess = epsilon - half_extent
+        if excess > TAIL_CUT * width:
+            return p_free
+        return p_free + (p_occ - p_free) * math.exp(-0.5 * (excess / width) ** 2)
+    if epsilon < -half_extent:
+        excess = -epsilon - half_extent
+        if excess > TAIL_CUT * width:
+            return 0.5
+        return 0.5 + (p_occ - 0.5) * math.exp(-0.5 * (excess / width) ** 2)
+    return p_occ
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
 def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, offsets, depth,
-                sigma_lut, lut_step, half_extents, n_sigmas, p_occ, p_free, transition, flush,
+                sigma_lut, lut_step, half_extents, tail_width, p_occ, p_free, transition, flush,
                 probabilities, states, visibility):
     """One frame of the grid, in place.
 
@@ -40,7 +58,7 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
     rotations (C, 3, 3), translations (C, 3), intrinsics (C, 4) float64; sizes (C, 2),
     offsets (C,) int64; depth (sum H*W,) float32 metres (<= 0 or not finite: no measurement)
     sigma_lut (C, L) float64 metres; lut_step float metres; half_extents (C,) float64 metres
-    n_sigmas, p_occ, p_free : floats of the observation function
+    tail_width, p_occ, p_free : floats of the observation function (tail width in noise stds)
     transition : (3, 3) float64, row = previous state, column = next state
     flush : float, posterior probabilities below it are set to 0 (no subnormal floats)
     probabilities : (N, 3) float32 in/out; states, visibility : (N,) uint8 out
@@ -49,40 +67,40 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
     lut_last = sigma_lut.shape[1] - 1
     for i in numba.prange(nx):
         x = origin[0] + cell * (i + 0.5)
+        column = np.empty((num_cameras, 3))  # camera-frame centre of cell (i, j, k)
         for j in range(ny):
             y = origin[1] + cell * (j + 0.5)
+            z0 = origin[2] + 0.5 * cell
+            for c in range(num_cameras):
+                for r in range(3):
+                    column[c, r] = (rotations[c, r, 0] * x + rotations[c, r, 1] * y + rotations[c, r, 2] * z0
+                                    + translations[c, r])
             for k in range(nz):
-                z = origin[2] + cell * (k + 0.5)
                 n = (i * ny + j) * nz + k
                 b_occupied = 1.0
                 b_empty = 1.0
                 covered = False
                 seen = False
                 for c in range(num_cameras):
-                    depth_l = rotations[c, 2, 0] * x + rotations[c, 2, 1] * y + rotations[c, 2, 2] * z + translations[c, 2]
+                    xc = column[c, 0] + k * cell * rotations[c, 0, 2]
+                    yc = column[c, 1] + k * cell * rotations[c, 1, 2]
+                    depth_l = column[c, 2] + k * cell * rotations[c, 2, 2]
                     if depth_l <= 0.0:
                         continue
-                    xc = rotations[c, 0, 0] * x + rotations[c, 0, 1] * y + rotations[c, 0, 2] * z + translations[c, 0]
-                    yc = rotations[c, 1, 0] * x + rotations[c, 1, 1] * y + rotations[c, 1, 2] * z + translations[c, 1]
-                    u = math.floor(intrinsics[c, 0] * xc / depth_l + intrinsics[c, 2] + 0.5)
-                    v = math.floor(intrinsics[c, 1] * yc / depth_l + intrinsics[c, 3] + 0.5)
+                    inverse = 1.0 / depth_l
+                    u = math.floor(intrinsics[c, 0] * xc * inverse + intrinsics[c, 2] + 0.5)
+                    v = math.floor(intrinsics[c, 1] * yc * inverse + intrinsics[c, 3] + 0.5)
                     if u < 0 or u >= sizes[c, 0] or v < 0 or v >= sizes[c, 1]:
                         continue
                     d = depth[offsets[c] + int(v) * sizes[c, 0] + int(u)]
                     if not (d > 0.0 and d < np.inf):
                         continue
                     covered = True
-                    m = int(depth_l / lut_step)
-                    band = n_sigmas * sigma_lut[c, min(m, lut_last)] + half_extents[c]
+                    width = tail_width * sigma_lut[c, min(int(depth_l / lut_step), lut_last)]
                     epsilon = d - depth_l
-                    if epsilon > band:
-                        f = p_free
+                    f = observation(epsilon, half_extents[c], width, p_occ, p_free)
+                    if epsilon >= -(half_extents[c] + TAIL_CUT * width):
                         seen = True
-                    elif epsilon >= -band:
-                        f = p_occ
-                        seen = True
-                    else:
-                        f = 0.5
                     b_occupied *= f
                     b_empty *= 1.0 - f
                 # forward step: Q_t ~ (Q_{t-1}^T A) o B_t
@@ -117,3 +135,56 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                     visibility[n] = HIDDEN
                 else:
                     visibility[n] = UNOBSERVED
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def cells_from_pixels(depth, fx, fy, cx, cy, rotation, translation, origin, cell, nx, ny, nz, states, out):
+    """Flat cell index of every pixel's back-projected point, in place.
+
+    depth : (H, W) float32 metres (<= 0 or not finite: no measurement)
+    fx, fy, cx, cy : floats, pixels; rotation (3, 3), translation (3,) float64: world_from_camera
+    origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
+    states : (N,) uint8 cell states, or an empty array; when given, a point in an E cell (2)
+        moves to the O or M cell among the 26 around it whose centre is nearest (first in
+        (di, dj, dk) lexicographic order on ties), if any
+    out : (H * W,) int64, -1 where there is no measurement or the point is outside the grid
+    """
+    height, width = depth.shape
+    use_states = states.size > 0
+    for v in numba.prange(height):
+        for u in range(width):
+            p = v * width + u
+            out[p] = -1
+            d = depth[v, u]
+            if not (d > 0.0 and d < np.inf):
+                continue
+            xc = (u - cx) * d / fx
+            yc = (v - cy) * d / fy
+            px = rotation[0, 0] * xc + rotation[0, 1] * yc + rotation[0, 2] * d + translation[0]
+            py = rotation[1, 0] * xc + rotation[1, 1] * yc + rotation[1, 2] * d + translation[1]
+            pz = rotation[2, 0] * xc + rotation[2, 1] * yc + rotation[2, 2] * d + translation[2]
+            i = int(math.floor((px - origin[0]) / cell))
+            j = int(math.floor((py - origin[1]) / cell))
+            k = int(math.floor((pz - origin[2]) / cell))
+            if i < 0 or i >= nx or j < 0 or j >= ny or k < 0 or k >= nz:
+                continue
+            n = (i * ny + j) * nz + k
+            if use_states and states[n] == 2:
+                best = np.inf
+                for di in range(-1, 2):
+                    for dj in range(-1, 2):
+                        for dk in range(-1, 2):
+                            a, b, c = i + di, j + dj, k + dk
+                            if a < 0 or a >= nx or b < 0 or b >= ny or c < 0 or c >= nz:
+                                continue
+                            m = (a * ny + b) * nz + c
+                            if states[m] == 2:
+                                continue
+                            ex = origin[0] + cell * (a + 0.5) - px
+                            ey = origin[1] + cell * (b + 0.5) - py
+                            ez = origin[2] + cell * (c + 0.5) - pz
+                            dist = ex * ex + ey * ey + ez * ez
+                            if dist < best:
+                                best = dist
+                                n = m
+            out[p] = n

@@ -5,21 +5,35 @@ states of the first paper (section III-A): ``O`` occupied by a static object, ``
 occupied by a moving object, ``E`` empty. Each frame, the cell centre is projected into
 every depth image; with ``l`` the centre's depth along that camera's optical axis and
 ``d`` the measured depth at its pixel, ``epsilon = d - l`` gives the observation function
-(the paper's Fig. 3, :func:`observation_function`)::
+(the paper's Fig. 3, :func:`observation_function`), a plateau as wide as the cell with
+edges blurred by the sensor's depth noise::
 
-    f(epsilon) = p_occ  where |epsilon| <= band    (the surface is in the cell: occupied)
-                 p_free where epsilon > band       (the camera sees through it: empty)
-                 0.5    where epsilon < -band      (hidden behind the surface: no information)
-                 0.5    where d is 0 or the centre is outside the image or behind the camera
+    f(epsilon) = p_occ                                              |epsilon| <= h   (surface in the cell: occupied)
+                 p_free + (p_occ - p_free) exp(-(epsilon - h)^2 / 2 w^2)   epsilon > h      (seen through: empty)
+                 0.5 + (p_occ - 0.5) exp(-(epsilon + h)^2 / 2 w^2)         epsilon < -h     (hidden: no information)
+                 0.5 where d is 0 or the centre is outside the image or behind the camera
 
-    band = n_sigmas * depth_std(l) + h
+with ``h`` half the cell's extent along the optical axis, ``cell / 2 * (|r_x| + |r_y| + |r_z|)``
+for the camera's viewing direction ``r`` in world axes, and ``w = tail_width * s`` where ``s``
+is the sensor's random depth error at that distance (:func:`occupose.synth.noise.depth_std`
+of the camera's noise model; ``tail_width`` 2 by default). The tails stop at ``band = h + 3 w``,
+beyond which f is exactly ``p_free`` or 0.5 (the tail is down to 1 % there). A cell is
+*visible* from a camera when ``epsilon >= -band`` (in front of or on the measured surface,
+within the noise) and *hidden* when ``epsilon < -band``.
 
-with ``depth_std`` the sensor's random depth error at that distance
-(:func:`occupose.synth.noise.depth_std` of the camera's noise model) and ``h`` half the
-cell's extent along the optical axis, ``cell / 2 * (|r_x| + |r_y| + |r_z|)`` for the
-camera's viewing direction ``r`` in world axes. The states' likelihoods are
-``B = (f, f, 1 - f)`` (O and M look alike: the aliasing the HMM resolves over time); the
-likelihoods of several cameras multiply, and a camera that does not cover a cell adds nothing.
+Why blurred edges, and why twice the noise: a cell whose centre lies near the edge of the
+occupied plateau gets "occupied" and "free" readings by turns as the noise moves the
+surface across it; every run of free readings makes it E and the next occupied one M, so
+a noisy wall grows a flickering layer of "moving" cells. In ``no_occlusion`` (Kinect v1,
+rear wall at 4.2 m) a hard step at ``h + 3 s`` gave about 1500 such cells and 1300 false
+foreground pixels per frame; tails of width ``s`` still about 480 cells, because the Kinect
+v1 quantises depth in steps of 5.4 cm at 4.2 m (against s = 2.9 cm there), so the readings
+of one surface fall on two or three levels about 2 s apart; tails of width ``2 s`` leave
+about 20 cells (25 pixels) and make readings near the edge close to uninformative.
+
+The states' likelihoods are ``B = (f, f, 1 - f)`` (O and M look alike: the aliasing the HMM
+resolves over time); the likelihoods of several cameras multiply, and a camera that does
+not cover a cell adds nothing.
 
 Transition matrix (rows: state at t-1, columns: state at t, order O, M, E), the paper's
 Fig. 4 with its extra M -> O transition ``psi``::
@@ -34,18 +48,27 @@ moving by leaving its cells, O -> E, and entering others, E -> M). Forward updat
 ``Q_t ~ (Q_{t-1}^T A) o B_t``, normalised; the cell's state is the MAP of ``Q_t``.
 
 How long until something that moved becomes background again. O and M always have the
-same likelihood, so their posterior ratio ``r = P(O) / P(M)`` does not depend on the
-observations: with ``a = (1 - alpha) / (1 - gamma - psi)`` and ``b = psi / (1 - gamma - psi)``
-it follows ``r_{t+1} = a r_t + b`` (ignoring the E -> M inflow, which dies out within a few
-frames of a cell being seen occupied). A cell entered from E starts at ``r_0 = 0``, so
-``r_t = b (a^t - 1) / (a - 1)``, and it turns O when ``r_t > 1``::
+same likelihood, so their posterior ratio ``r = P(O) / P(M)`` does not depend on how
+strongly the cell is seen occupied, only on the flows into O and M. While a cell is seen
+occupied, O receives ``(1 - alpha) O + psi M`` and M receives ``(1 - gamma - psi) M + beta E``,
+where the empty share settles within a few frames at ``E = e M`` with ``e`` the positive root
+of ``beta e^2 + (1 - gamma - psi - k (1 - beta)) e - k gamma = 0``, ``k = (1 - p_occ) / p_occ``
+(E receives ``(1 - p_occ) (gamma M + (1 - beta) E)`` against M's ``p_occ (...)``). So::
 
-    T = ln(1 + (a - 1) / b) / ln(a) = ln(1 + (gamma - alpha + psi) / psi) / ln((1 - alpha) / (1 - gamma - psi))
-      ~ (-ln psi + ln(gamma - alpha)) / ln((1 - alpha) / (1 - gamma))
+    r_{t+1} = a r_t + b,   a = (1 - alpha) / (1 - gamma - psi + beta e),   b = psi / (1 - gamma - psi + beta e)
 
-For the defaults (alpha 0.01, gamma 0.4, psi e^-38): ``T = (38 - 0.94) / 0.501 = 74.0``
-frames, 2.5 s at 30 fps (:func:`frames_until_static`). The same holds for a person who
-stands perfectly still: after ``T`` frames they are background.
+A cell entered from E starts at ``r_0 = 0`` (no E -> O), so ``r_t = b (a^t - 1) / (a - 1)``, and
+its MAP turns from M to O when ``r_t > 1``::
+
+    T = ln(1 + (a - 1) / b) / ln(a) = ln(1 + (gamma - alpha + psi - beta e) / psi) / ln(a)
+      ~ (-ln psi + ln(gamma - alpha - beta e)) / ln(a)
+
+For the defaults (alpha 0.01, beta 0.1, gamma 0.4, psi e^-38, p_occ 0.9): ``e = 0.087``,
+``a = 1.626``, ``T = (38 - 0.96) / 0.486 = 76.2`` frames (:func:`frames_until_static`), 2.5 s
+at 30 fps; one more frame passes while the cell enters (E -> M), so a cell first seen
+occupied at frame ``t0`` is O from frame ``t0 + 77`` (a single-cell filter run gives exactly
+that). Without the E share (``e = 0``) the figure would be 74.0. The same holds for a
+person who stands perfectly still: after ``T`` frames they are background.
 
 Initial distribution (``initial``, default ``(0.4, 0, 0.6)`` for O, M, E). One frame
 cannot tell a static object from a moving one, and the ratio argument above shows that the
@@ -72,7 +95,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points, points_from_depth
+from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
 from occupose.synth.noise import depth_std
@@ -85,7 +108,7 @@ UNOBSERVED, VISIBLE, HIDDEN = _kernels.UNOBSERVED, _kernels.VISIBLE, _kernels.HI
 
 ALPHA, BETA, GAMMA, PSI = 0.01, 0.1, 0.4, math.exp(-38.0)
 P_OCC, P_FREE = 0.9, 0.05
-N_SIGMAS = 3.0
+TAIL_WIDTH = 2.0
 INITIAL = (0.4, 0.0, 0.6)
 #: Noise model for cameras whose intrinsics match no sensor preset (the noisier of the two).
 DEFAULT_NOISE_MODEL = "structured_light"
@@ -100,19 +123,27 @@ _LUT_DEPTH = 12.0
 # ------------------------------------------------------------------------- the model
 
 
-def observation_function(epsilon, band, p_occ: float = P_OCC, p_free: float = P_FREE) -> np.ndarray:
+def observation_function(epsilon, half_extent, width, p_occ: float = P_OCC, p_free: float = P_FREE) -> np.ndarray:
     """The paper's Fig. 3: P(observation | cell occupied) as a function of epsilon = d - l.
 
     epsilon : (...) float, metres, measured depth minus the cell centre's depth (NaN: no
-        measurement or the cell is not in the image)
-    band : float or (...) float, metres, half width of the occupied band
-    Returns (...) float64: ``p_occ`` where |epsilon| <= band, ``p_free`` where epsilon >
-    band (seen through), 0.5 where epsilon < -band (hidden) or epsilon is NaN.
+        measurement, or the cell is not in the image)
+    half_extent : float or (...) float, metres, half the cell's extent along the optical axis
+    width : float or (...) float, metres, the Gaussian tails' width (``tail_width`` times the
+        sensor's depth noise at the cell's depth)
+    Returns (...) float64 (module docstring): ``p_occ`` where |epsilon| <= half_extent, Gaussian
+    tails down to ``p_free`` (epsilon > 0, seen through) and to 0.5 (epsilon < 0, hidden),
+    exactly ``p_free`` / 0.5 beyond ``half_extent + 3 * width``, and 0.5 where epsilon is NaN.
     """
-    epsilon = np.asarray(epsilon, np.float64)
-    band = np.asarray(band, np.float64)
-    with np.errstate(invalid="ignore"):
-        return np.where(epsilon > band, p_free, np.where(epsilon >= -band, p_occ, 0.5))
+    epsilon, half_extent, width = np.broadcast_arrays(
+        *(np.asarray(a, np.float64) for a in (epsilon, half_extent, width)))
+    excess = np.abs(epsilon) - half_extent
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tail = np.where(excess > _kernels.TAIL_CUT * width, 0.0,
+                        np.exp(-0.5 * (np.maximum(excess, 0.0) / width) ** 2))
+        tail = np.where(excess <= 0.0, 1.0, tail)
+        far = np.where(epsilon > 0.0, p_free, 0.5)
+        return np.where(np.isnan(epsilon), 0.5, far + (p_occ - far) * tail)
 
 
 def transition_matrix(alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA,
@@ -128,20 +159,29 @@ def transition_matrix(alpha: float = ALPHA, beta: float = BETA, gamma: float = G
                      [0.0, beta, 1.0 - beta]])
 
 
-def frames_until_static(alpha: float = ALPHA, gamma: float = GAMMA, psi: float = PSI) -> float:
-    """Frames a cell entered from E and then seen occupied stays M before it turns O.
+def frames_until_static(alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
+                        p_occ: float = P_OCC) -> float:
+    """Frames a cell entered from E and then seen occupied spends in M before it turns O.
 
-    ``T = ln(1 + (gamma - alpha + psi) / psi) / ln((1 - alpha) / (1 - gamma - psi))`` (the
-    module docstring derives it); 74.0 for the defaults. Returns inf when psi is 0 or when
-    O does not outlast M (``alpha >= gamma + psi``).
+    ``T = ln(1 + (gamma - alpha + psi - beta e) / psi) / ln((1 - alpha) / (1 - gamma - psi + beta e))``
+    with ``e`` the settled E / M ratio (the module docstring derives it): 76.2 for the
+    defaults. Returns inf when psi is 0 or when M outlasts O (``a <= 1``).
     """
-    transition_matrix(alpha, 0.0, gamma, psi)
-    a = (1.0 - alpha) / (1.0 - gamma - psi) if gamma + psi < 1.0 else math.inf
-    if psi == 0.0 or a <= 1.0:
+    transition_matrix(alpha, beta, gamma, psi)
+    if not 0.5 < p_occ <= 1.0:
+        raise ValueError(f"p_occ must be in (0.5, 1], got {p_occ!r}")
+    k = (1.0 - p_occ) / p_occ
+    linear = 1.0 - gamma - psi - k * (1.0 - beta)
+    if beta > 0.0:
+        e = (-linear + math.sqrt(linear * linear + 4.0 * beta * k * gamma)) / (2.0 * beta)
+    else:
+        e = k * gamma / linear if linear > 0.0 else math.inf
+    stay = 1.0 - gamma - psi + beta * e
+    if psi == 0.0 or not (stay < 1.0 - alpha):
         return math.inf
-    if math.isinf(a):
+    if stay == 0.0:
         return 0.0
-    return math.log1p((gamma - alpha + psi) / psi) / math.log(a)
+    return math.log1p((gamma - alpha + psi - beta * e) / psi) / math.log((1.0 - alpha) / stay)
 
 
 # ------------------------------------------------------------------------- geometry
@@ -281,28 +321,11 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
     return spec
 
 
-_NEIGHBOURS = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)])
-
-
 def _check_states(states: np.ndarray, spec: GridSpec) -> np.ndarray:
     states = np.asarray(states)
     if states.shape != spec.shape or states.dtype != np.uint8:
         raise ValueError(f"states must be a uint8 {spec.shape} array of cell states, got {states.dtype} {states.shape}")
     return states
-
-
-def _nearest_occupied(points: np.ndarray, index: np.ndarray, states: np.ndarray, spec: GridSpec) -> np.ndarray:
-    """(P, 3) cells: for each point, the O or M cell among the 26 around ``index`` whose centre is
-    nearest, or ``index`` itself when none is occupied."""
-    candidates = index[:, None, :] + _NEIGHBOURS[None]
-    inside = np.all((candidates >= 0) & (candidates < np.asarray(spec.shape)), axis=2)
-    clipped = np.clip(candidates, 0, np.asarray(spec.shape) - 1)
-    occupied = inside & (states[clipped[..., 0], clipped[..., 1], clipped[..., 2]] != E)
-    centres = np.asarray(spec.origin) + spec.cell * (candidates + 0.5)
-    distance = np.where(occupied, np.sum((centres - points[:, None, :]) ** 2, axis=2), np.inf)
-    best = np.argmin(distance, axis=1)
-    rows = np.arange(len(points))
-    return np.where(occupied[rows, best][:, None], candidates[rows, best], index)
 
 
 def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: np.ndarray | None = None) -> np.ndarray:
@@ -317,16 +340,21 @@ def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: 
     Returns (H, W) int64: flat cell index ``(i * ny + j) * nz + k`` into ``spec.shape``, -1
     where there is no measurement or the point is outside the grid.
     """
-    points, pixels = points_from_depth(depth, camera)
-    index, inside = spec.cells_from_points(points)
-    points, pixels, index = points[inside], pixels[inside], index[inside]
-    if states is not None:
-        states = _check_states(states, spec)
-        empty = states[index[:, 0], index[:, 1], index[:, 2]] == E
-        index[empty] = _nearest_occupied(points[empty], index[empty], states, spec)
-    nx, ny, nz = spec.shape
-    out = np.full(camera.height * camera.width, -1, np.int64)
-    out[pixels] = (index[:, 0] * ny + index[:, 1]) * nz + index[:, 2]
+    depth = np.asarray(depth)
+    if depth.shape != (camera.height, camera.width):
+        raise ValueError(f"depth image for camera {camera.name!r} must have shape ({camera.height}, {camera.width}), "
+                         f"got {depth.shape}")
+    if depth.dtype == np.uint16:
+        depth = (depth * camera.depth_scale).astype(np.float32)
+    elif depth.dtype.kind != "f":
+        raise ValueError(
+            f"depth image for camera {camera.name!r} must be float metres or uint16 raw, got {depth.dtype}")
+    states = np.zeros(0, np.uint8) if states is None else _check_states(states, spec).reshape(-1)
+    out = np.empty(camera.height * camera.width, np.int64)
+    pose = camera.world_from_camera
+    _kernels.cells_from_pixels(np.ascontiguousarray(depth, np.float32), camera.fx, camera.fy, camera.cx, camera.cy,
+                               np.ascontiguousarray(pose[:3, :3]), pose[:3, 3].copy(), np.asarray(spec.origin),
+                               spec.cell, *spec.shape, states, out)
     return out.reshape(camera.height, camera.width)
 
 
@@ -362,7 +390,8 @@ class OccupancyGrid:
         Default: the camera's sensor preset's model when its intrinsics match a preset,
         else DEFAULT_NOISE_MODEL.
     alpha, beta, gamma, psi : transition probabilities (module docstring)
-    p_occ, p_free : the observation function's levels; n_sigmas : band width in depth standard deviations
+    p_occ, p_free : the observation function's levels; tail_width : width of its tails in
+        sensor depth standard deviations (module docstring)
     initial : (3,) initial distribution over (O, M, E), summing to 1 (module docstring)
     max_range : as in :func:`spec_from_cameras`, used to check each camera sees part of the grid
 
@@ -373,7 +402,7 @@ class OccupancyGrid:
 
     def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str] | None = None, *,
                  alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
-                 p_occ: float = P_OCC, p_free: float = P_FREE, n_sigmas: float = N_SIGMAS,
+                 p_occ: float = P_OCC, p_free: float = P_FREE, tail_width: float = TAIL_WIDTH,
                  initial=INITIAL, max_range=None):
         if not isinstance(spec, GridSpec):
             raise ValueError(f"spec must be a GridSpec, got {type(spec).__name__}")
@@ -383,9 +412,9 @@ class OccupancyGrid:
         self.alpha, self.beta, self.gamma, self.psi = float(alpha), float(beta), float(gamma), float(psi)
         if not (0.5 < p_occ <= 1.0 and 0.0 <= p_free < 0.5):
             raise ValueError(f"need 0.5 < p_occ <= 1 and 0 <= p_free < 0.5, got p_occ={p_occ!r}, p_free={p_free!r}")
-        if not (math.isfinite(n_sigmas) and n_sigmas >= 0):
-            raise ValueError(f"n_sigmas must be a number >= 0, got {n_sigmas!r}")
-        self.p_occ, self.p_free, self.n_sigmas = float(p_occ), float(p_free), float(n_sigmas)
+        if not (math.isfinite(tail_width) and tail_width >= 0):
+            raise ValueError(f"tail_width must be a number >= 0, got {tail_width!r}")
+        self.p_occ, self.p_free, self.tail_width = float(p_occ), float(p_free), float(tail_width)
         initial = np.asarray(initial, np.float64)
         if initial.shape != (3,) or np.any(initial < 0) or abs(initial.sum() - 1.0) > 1e-6:
             raise ValueError(f"initial must be 3 probabilities for (O, M, E) summing to 1, got {initial.tolist()}")
@@ -434,11 +463,22 @@ class OccupancyGrid:
             self._sigma_lut[c] = depth_std(lut_depths, self.noise_models[cam.name])
         self._depth = np.empty(offset, np.float32)
 
-    def band(self, depth_l, camera: str) -> np.ndarray:
-        """Half width (metres) of the occupied band for cells at depth ``depth_l`` (metres) from camera ``camera``."""
-        c = [cam.name for cam in self.cameras].index(camera)
+    def depth_noise(self, depth_l, camera: str) -> np.ndarray:
+        """The depth noise (one standard deviation, metres) the grid assumes for camera ``camera``
+        at depth ``depth_l`` ((...) float, metres), as tabulated in 1 cm steps."""
+        c = self._camera_index(camera)
         m = np.minimum((np.asarray(depth_l, np.float64) / _LUT_STEP).astype(np.int64), self._sigma_lut.shape[1] - 1)
-        return self.n_sigmas * self._sigma_lut[c, m] + self._half_extents[c]
+        return self._sigma_lut[c, m]
+
+    def half_extent(self, camera: str) -> float:
+        """Half a cell's extent (metres) along camera ``camera``'s optical axis."""
+        return float(self._half_extents[self._camera_index(camera)])
+
+    def _camera_index(self, camera: str) -> int:
+        names = [cam.name for cam in self.cameras]
+        if camera not in names:
+            raise ValueError(f"unknown camera {camera!r}; the grid's cameras are {names}")
+        return names.index(camera)
 
     def _check_depths(self, depths: Mapping[str, np.ndarray]) -> None:
         names = [c.name for c in self.cameras]
@@ -467,7 +507,7 @@ class OccupancyGrid:
         _kernels.update_grid(
             np.asarray(self.spec.origin), self.spec.cell, nx, ny, nz, self._rotations, self._translations,
             self._intrinsics, self._sizes, self._offsets, self._depth, self._sigma_lut, _LUT_STEP,
-            self._half_extents, self.n_sigmas, self.p_occ, self.p_free, self.transition, FLUSH,
+            self._half_extents, self.tail_width, self.p_occ, self.p_free, self.transition, FLUSH,
             self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
         )
         self.num_updates += 1

@@ -1,0 +1,391 @@
+"""Stage 1: the occupancy grid's HMM and observation function against NumPy references, and
+on rendered scenes (procedural motion, no shared data): a person extracted as moving, a
+moved chair that becomes background again after the time psi implies, cells hidden behind
+a desk."""
+
+import math
+import sys
+
+import numpy as np
+import pytest
+
+from occupose.camera import Camera, camera_preset, look_at, pixels_from_points, points_from_depth, sensor_spec
+from occupose.grid.baseline import DepthBackgroundSubtractor
+from occupose.grid.occupancy import (
+    FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth, foreground_from_grid,
+    frames_until_static, observation_function, spec_from_cameras, transition_matrix,
+)
+from occupose.grid.spec import GridSpec
+from occupose.joints import JOINT_INDEX
+from occupose.metrics import foreground_scores
+from occupose.synth.generate import frames
+from occupose.synth.noise import depth_std
+from occupose.synth.render import render_camera
+from occupose.synth.scenarios import build_scenario
+
+FRONT = camera_preset("kinect_v1", world_from_camera=look_at((0.0, 0.0, 1.6), (0.0, 3.0, 0.9)), camera_name="front")
+
+
+# ------------------------------------------------------------------ NumPy references
+
+
+def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarray):
+    """One frame of the grid in plain NumPy: (probabilities (N, 3) float64, states (N,), visibility (N,))."""
+    centres = grid.spec.centers().reshape(-1, 3)
+    likelihood = np.ones((len(centres), 3))
+    covered = np.zeros(len(centres), bool)
+    seen = np.zeros(len(centres), bool)
+    for cam in grid.cameras:
+        uv, depth_l = pixels_from_points(centres, cam)
+        with np.errstate(invalid="ignore"):
+            u, v = np.floor(uv[:, 0] + 0.5), np.floor(uv[:, 1] + 0.5)
+            inside = (depth_l > 0) & (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+        d = np.full(len(centres), np.nan)
+        d[inside] = depths[cam.name][v[inside].astype(int), u[inside].astype(int)]
+        with np.errstate(invalid="ignore"):
+            valid = inside & (d > 0) & np.isfinite(d)
+        width = grid.tail_width * grid.depth_noise(np.where(valid, depth_l, 0.0), cam.name)
+        band = grid.half_extent(cam.name) + 3 * width
+        epsilon = np.where(valid, d - depth_l, np.nan)
+        f = observation_function(epsilon, grid.half_extent(cam.name), width, grid.p_occ, grid.p_free)
+        likelihood *= np.column_stack([f, f, 1.0 - f])
+        covered |= valid
+        with np.errstate(invalid="ignore"):
+            seen |= valid & (epsilon >= -band)
+    q = (probabilities.astype(np.float64) @ grid.transition) * likelihood
+    q /= q.sum(axis=1, keepdims=True)
+    q[q < FLUSH] = 0.0
+    visibility = np.where(seen, VISIBLE, np.where(covered, HIDDEN, UNOBSERVED))
+    return q, np.argmax(q, axis=1), visibility
+
+
+def reference_cells(depth, camera, spec, states=None):
+    """cells_from_depth in NumPy: back-project, bin, and move points in E cells to the nearest occupied neighbour."""
+    points, pixels = points_from_depth(depth, camera)
+    index, inside = spec.cells_from_points(points)
+    points, pixels, index = points[inside], pixels[inside], index[inside]
+    if states is not None:
+        offsets = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)])
+        for p in np.flatnonzero(states[tuple(index.T)] == E):
+            candidates = index[p] + offsets
+            ok = np.all((candidates >= 0) & (candidates < spec.shape), axis=1)
+            ok[ok] = states[tuple(candidates[ok].T)] != E
+            if ok.any():
+                centres = np.asarray(spec.origin) + spec.cell * (candidates[ok] + 0.5)
+                index[p] = candidates[ok][np.argmin(np.sum((centres - points[p]) ** 2, axis=1))]
+    out = np.full(camera.height * camera.width, -1)
+    out[pixels] = np.ravel_multi_index(tuple(index.T), spec.shape)
+    return out.reshape(camera.height, camera.width)
+
+
+def single_cell_frames_until_o(grid: OccupancyGrid) -> int:
+    """Run one cell's filter: settled empty (seen through), then seen occupied every frame;
+    the number of occupied frames until its MAP is O."""
+    q = np.array([0.0, 0.0, 1.0])
+    for _ in range(300):
+        q = (q @ grid.transition) * np.array([grid.p_free, grid.p_free, 1.0 - grid.p_free])
+        q /= q.sum()
+    for t in range(1, 10_000):
+        q = (q @ grid.transition) * np.array([grid.p_occ, grid.p_occ, 1.0 - grid.p_occ])
+        q /= q.sum()
+        if np.argmax(q) == O:
+            return t
+    raise AssertionError("never static")
+
+
+def random_setup(rng, num_cameras=2):
+    """A small grid seen by small random cameras, random depth images with holes, random beliefs."""
+    spec = GridSpec((-1.0, -1.0, 0.0), 0.1, (20, 18, 16))
+    cameras = []
+    for c in range(num_cameras):
+        angle = rng.uniform(0, 2 * np.pi)
+        eye = (3.0 * math.cos(angle), 3.0 * math.sin(angle), rng.uniform(0.5, 2.5))
+        cameras.append(Camera(f"cam{c}", 64, 48, 50.0 + 10 * c, 52.0, 31.7, 23.2,
+                              world_from_camera=look_at(eye, rng.uniform(-0.5, 0.5, 3) + (0, 0, 0.8))))
+    depths = {}
+    for cam in cameras:
+        d = rng.uniform(1.0, 5.0, (cam.height, cam.width)).astype(np.float32)
+        d[rng.random(d.shape) < 0.1] = 0.0
+        d[rng.random(d.shape) < 0.01] = np.nan
+        depths[cam.name] = d
+    models = dict(zip([c.name for c in cameras], ("structured_light", "tof")))
+    grid = OccupancyGrid(spec, cameras, models, p_free=0.08)
+    grid._probabilities[...] = rng.dirichlet((0.5, 0.5, 0.5), spec.shape).astype(np.float32)
+    return grid, depths
+
+
+# ------------------------------------------------------------------ the model
+
+
+def test_observation_function_has_the_papers_shape():
+    h, w = 0.03, 0.01
+    epsilon = np.array([-1.0, -0.0601, -0.04, -0.03, 0.0, 0.03, 0.04, 0.0599, 0.0601, 2.0, np.nan])
+    f = observation_function(epsilon, h, w, p_occ=0.9, p_free=0.05)
+    tail = math.exp(-0.5)
+    np.testing.assert_allclose(f, [0.5, 0.5, 0.5 + 0.4 * tail, 0.9, 0.9, 0.9, 0.05 + 0.85 * tail,
+                                   0.05 + 0.85 * math.exp(-0.5 * 2.99**2), 0.05, 0.05, 0.5])
+    # occupied near 0, low when seen through, uninformative when hidden, monotone in between
+    grid = np.linspace(0.0, 0.2, 201)
+    assert np.all(np.diff(observation_function(grid, h, w)) <= 0)
+    assert np.all(np.diff(observation_function(-grid, h, w)) <= 0)
+    assert observation_function(0.0, h, 0.0) == P_OCC and observation_function(0.031, h, 0.0) == P_FREE
+
+
+def test_tolerance_grows_with_the_sensor_noise():
+    grid = OccupancyGrid(spec_from_cameras([FRONT], cell=0.1), [FRONT])
+    assert grid.noise_models == {"front": "structured_light"}  # from the Kinect v1 preset
+    # half a 10 cm cell along the viewing direction
+    assert grid.half_extent("front") == pytest.approx(0.05 * np.abs(FRONT.camera_from_world[2, :3]).sum())
+    z = np.array([1.0, 2.5, 4.0])
+    np.testing.assert_allclose(grid.depth_noise(z, "front"), depth_std(z, "structured_light"), atol=1e-4)
+    assert grid.depth_noise(4.0, "front") > 5 * grid.depth_noise(1.0, "front")
+    with pytest.raises(ValueError, match="unknown camera 'side'"):
+        grid.half_extent("side")
+
+
+def test_transition_matrix_has_the_papers_transitions():
+    a = transition_matrix(0.01, 0.1, 0.4, 1e-3)
+    np.testing.assert_allclose(a.sum(axis=1), 1.0)
+    assert a[E, O] == 0.0 and a[O, M] == 0.0  # no E -> O, no O -> M
+    assert (a[O, E], a[E, M], a[M, E], a[M, O]) == (0.01, 0.1, 0.4, 1e-3)
+    with pytest.raises(ValueError, match="alpha"):
+        transition_matrix(alpha=1.5)
+    with pytest.raises(ValueError, match="gamma \\+ psi"):
+        transition_matrix(gamma=0.9, psi=0.2)
+
+
+@pytest.mark.parametrize("params", [{}, {"psi": math.exp(-19)}, {"gamma": 0.3, "psi": math.exp(-25)},
+                                    {"alpha": 0.05, "beta": 0.2}, {"p_occ": 0.8}])
+def test_frames_until_static_matches_a_single_cell_run(params):
+    grid = OccupancyGrid(GridSpec((0, 3, 0.8), 0.1, (2, 2, 2)), [FRONT], **params)
+    derived = frames_until_static(**params)
+    # the derived figure plus the frame it takes to enter (E -> M)
+    assert single_cell_frames_until_o(grid) == math.ceil(derived) + 1
+
+
+def test_frames_until_static_default_figure():
+    assert frames_until_static() == pytest.approx(76.155, abs=1e-3)
+    assert frames_until_static(beta=0.0) == pytest.approx((38 + math.log(0.39)) / math.log(0.99 / 0.6), abs=1e-6)
+    assert frames_until_static(psi=0.0) == math.inf
+
+
+def test_initial_distribution_learns_the_background_in_one_frame():
+    grid = OccupancyGrid(spec_from_cameras([FRONT], cell=0.1), [FRONT])
+    assert np.all(grid.states == E) and np.all(grid.visibility == UNOBSERVED)
+    wall = np.full((FRONT.height, FRONT.width), 3.0, np.float32)
+    grid.update({"front": wall})
+    on_wall = (grid.visibility == VISIBLE) & (grid.states != E)
+    assert np.all(grid.states[grid.visibility == UNOBSERVED] == E)  # unknown space is empty
+    assert np.all(grid.states[grid.visibility == HIDDEN] == E)
+    assert on_wall.sum() > 100 and np.all(grid.states[on_wall] == O)  # the background is static at once
+    assert grid.num_updates == 1 and not grid.moving_mask().any()
+
+
+# ------------------------------------------------------------------ kernels vs NumPy
+
+
+def test_update_kernel_matches_numpy(rng):
+    grid, depths = random_setup(rng)
+    before = grid.probabilities.reshape(-1, 3).copy()
+    expected, states, visibility = reference_update(grid, depths, before)
+    grid.update(depths)
+    np.testing.assert_allclose(grid.probabilities.reshape(-1, 3), expected, atol=1e-6, rtol=0)
+    np.testing.assert_array_equal(grid.states.reshape(-1), states)
+    np.testing.assert_array_equal(grid.visibility.reshape(-1), visibility)
+    # every branch was exercised
+    assert set(np.unique(states)) == {O, M, E} and set(np.unique(visibility)) == {UNOBSERVED, VISIBLE, HIDDEN}
+    counts = np.bincount(grid.states.reshape(-1), minlength=3)
+    assert counts.min() > 50
+
+
+def test_update_kernel_matches_numpy_over_frames(rng):
+    grid, depths = random_setup(rng, num_cameras=1)
+    expected = grid.probabilities.reshape(-1, 3).astype(np.float64)
+    for _ in range(5):
+        depth = depths["cam0"] + rng.normal(0, 0.02, depths["cam0"].shape).astype(np.float32)
+        expected = reference_update(grid, {"cam0": depth}, expected.astype(np.float32))[0]
+        grid.update({"cam0": depth})
+    np.testing.assert_allclose(grid.probabilities.reshape(-1, 3), expected, atol=1e-6, rtol=0)
+
+
+def test_cells_from_depth_matches_numpy(rng):
+    grid, depths = random_setup(rng)
+    cam = grid.cameras[0]
+    depth = depths[cam.name]
+    # put points inside the grid: depths of the cell centres seen by the camera
+    uv, z = pixels_from_points(grid.spec.centers().reshape(-1, 3), cam)
+    ok = (z > 0) & np.all((uv >= 0) & (uv < (cam.width - 0.5, cam.height - 0.5)), axis=1)
+    depth[np.round(uv[ok, 1]).astype(int), np.round(uv[ok, 0]).astype(int)] = z[ok] + rng.normal(0, 0.05, ok.sum())
+    states = rng.choice(np.array([O, M, E], np.uint8), grid.spec.shape, p=(0.2, 0.2, 0.6))
+    plain = cells_from_depth(depth, cam, grid.spec)
+    np.testing.assert_array_equal(plain, reference_cells(depth, cam, grid.spec))
+    moved = cells_from_depth(depth, cam, grid.spec, states)
+    np.testing.assert_array_equal(moved, reference_cells(depth, cam, grid.spec, states))
+    assert (plain >= 0).sum() > 200 and np.count_nonzero(moved != plain) > 50
+    raw = np.round(np.nan_to_num(depth) * 1000).astype(np.uint16)
+    assert np.mean(cells_from_depth(raw, cam, grid.spec) == plain) > 0.95
+
+
+def test_foreground_from_grid_takes_states_or_a_mask(rng):
+    spec = GridSpec((-1.0, 2.0, 0.0), 0.1, (20, 20, 20))
+    wall = np.full((FRONT.height, FRONT.width), 3.0, np.float32)
+    index = cells_from_depth(wall, FRONT, spec)
+    states = np.full(spec.shape, O, np.uint8)
+    hit = np.unique(index[index >= 0])[:5]
+    states.reshape(-1)[hit] = M
+    expected = np.isin(index, hit)
+    np.testing.assert_array_equal(foreground_from_grid(states, spec, wall, FRONT), expected)
+    np.testing.assert_array_equal(foreground_from_grid(states == M, spec, wall, FRONT), expected)
+    with pytest.raises(ValueError, match="uint8"):
+        foreground_from_grid(states.astype(np.int32), spec, wall, FRONT)
+
+
+# ------------------------------------------------------------------ bad input
+
+
+def test_spec_from_cameras_covers_the_view():
+    spec = spec_from_cameras([FRONT])
+    far = sensor_spec("kinect_v1").far
+    assert spec.cell == 0.05
+    assert spec.origin[2] == pytest.approx(-0.025)  # the bottom layer is centred on the floor
+    # sample the view pyramid (rays from the camera to pixels at the far range), cut at the floor and 2.2 m
+    u, v = np.meshgrid(np.linspace(0, FRONT.width - 1, 33), np.linspace(0, FRONT.height - 1, 25))
+    far_points = np.column_stack([(u.ravel() - FRONT.cx) / FRONT.fx * far, (v.ravel() - FRONT.cy) / FRONT.fy * far,
+                                  np.full(u.size, far)])
+    far_points = far_points @ FRONT.world_from_camera[:3, :3].T + FRONT.position
+    fractions = np.linspace(0, 1, 401)[:, None, None]
+    points = (FRONT.position + fractions * (far_points - FRONT.position)).reshape(-1, 3)
+    points = points[(points[:, 2] >= 0) & (points[:, 2] <= 2.2)]
+    assert np.all(points.min(axis=0)[:2] >= np.asarray(spec.origin)[:2] - 1e-9)
+    assert np.all(points.max(axis=0) <= spec.high + 1e-9)
+    np.testing.assert_allclose(points.min(axis=0)[:2], np.asarray(spec.origin)[:2], atol=0.1)
+    np.testing.assert_allclose(points.max(axis=0), spec.high, atol=0.1)
+    explicit = spec_from_cameras([FRONT], bounds=((-1, 1, 0), (1, 3, 2)), cell=0.1)
+    assert explicit.shape == (20, 20, 20)
+    shorter = spec_from_cameras([FRONT], max_range=3.0)
+    assert shorter.high[1] < spec.high[1] - 0.5
+
+
+def test_bad_input_gives_clear_errors():
+    with pytest.raises(ValueError, match="high > low"):
+        spec_from_cameras([FRONT], bounds=((0, 1, 0), (0, 3, 2)))
+    with pytest.raises(ValueError, match="empty grid box"):
+        GridSpec((0, 0, 0), 0.05, (10, 0, 10))
+    up = camera_preset("kinect_v1", world_from_camera=look_at((0, 0, 2.5), (0, 1, 4.0)), camera_name="up")
+    with pytest.raises(ValueError, match="camera 'up' sees nothing.*outside the grid"):
+        spec_from_cameras([FRONT, up])
+    with pytest.raises(ValueError, match="camera 'front' sees no cell.*outside the grid"):
+        OccupancyGrid(GridSpec((-1, -3, 0), 0.1, (10, 10, 10)), [FRONT])  # the box is behind it
+    grid = OccupancyGrid(GridSpec((-1, 2, 0), 0.1, (10, 10, 10)), [FRONT])
+    with pytest.raises(ValueError, match=r"shape \(480, 640\), got \(240, 320\)"):
+        grid.update({"front": np.zeros((240, 320), np.float32)})
+    with pytest.raises(ValueError, match="float32 metres, got uint16"):
+        grid.update({"front": np.zeros((480, 640), np.uint16)})
+    with pytest.raises(ValueError, match="one image per camera"):
+        grid.update({"side": np.zeros((480, 640), np.float32)})
+    with pytest.raises(ValueError, match="noise model"):
+        OccupancyGrid(GridSpec((-1, 2, 0), 0.1, (10, 10, 10)), [FRONT], {"front": "laser"})
+    with pytest.raises(ValueError, match="initial"):
+        OccupancyGrid(GridSpec((-1, 2, 0), 0.1, (10, 10, 10)), [FRONT], initial=(0.5, 0.5, 0.5))
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        grid.visibility_at(np.zeros(3))
+
+
+def test_baseline_needs_opencv_and_finds_a_new_object(monkeypatch):
+    subtractor = DepthBackgroundSubtractor("mog2", history=50)
+    rng = np.random.default_rng(0)
+    wall = np.full((48, 64), 3.0)
+    for _ in range(30):
+        foreground = subtractor.apply(wall + rng.normal(0, 0.005, wall.shape))
+    assert foreground.mean() < 0.01
+    scene = wall.copy()
+    scene[10:30, 20:40] = 2.0
+    scene[0, 0] = 0.0
+    foreground = subtractor.apply(scene)
+    assert foreground[10:30, 20:40].all() and foreground.sum() == 400
+    with pytest.raises(ValueError, match="valid names"):
+        DepthBackgroundSubtractor("median")
+    monkeypatch.setitem(sys.modules, "cv2", None)
+    with pytest.raises(ImportError, match=r"pip install occupose\[baseline\]"):
+        DepthBackgroundSubtractor("knn")
+
+
+# ------------------------------------------------------------------ rendered scenes
+
+
+def test_person_present_at_the_first_frame_is_extracted():
+    # no_occlusion from frame 188, where the person is walking; the grid starts there
+    scenario = build_scenario("no_occlusion", use_mocap=False)
+    cam = scenario.cameras[0]
+    spec = spec_from_cameras(scenario.cameras)
+    grid = OccupancyGrid(spec, scenario.cameras)
+    ious = []
+    for frame in frames(scenario, seed=3, indices=range(188, 238)):
+        assert frame.present[0]
+        grid.update(frame.depth)
+        predicted = foreground_from_grid(grid.states, spec, frame.depth[cam.name], cam)
+        ious.append(foreground_scores(predicted, frame.rendered[cam.name].person > 0)[2])
+    assert ious[10] > 0.7  # moving within 10 frames
+    assert np.mean(ious[10:]) >= 0.8
+    assert np.mean(ious[20:]) >= 0.9
+
+
+def chair_pixels(scenario, frame, cam) -> np.ndarray:
+    """(H, W) bool: pixels where the moved chair is the nearest surface."""
+    rendered = frame.rendered[cam.name]
+    alone = render_camera(scenario.moving_at(frame.index), cam).depth
+    return (alone > 0) & (np.abs(alone - rendered.depth) < 1e-6) & (rendered.person == 0)
+
+
+def test_moved_chair_becomes_background_after_the_derived_time():
+    scenario = build_scenario("moved_chair", use_mocap=False)
+    cam = scenario.cameras[0]
+    drop = scenario.events["carried"][1]  # first frame with the chair at its final place
+    derived = math.ceil(frames_until_static())  # 77 frames with the default psi = e^-38
+    assert derived == 77
+    spec = spec_from_cameras(scenario.cameras)
+    grid = OccupancyGrid(spec, scenario.cameras)
+    checks = {drop - 5: "carried", drop + derived // 2: "resting", drop + derived - 8: "resting",
+              drop + derived: "static"}
+    share = {}
+    for frame in frames(scenario, seed=4, indices=range(drop - 60, drop + derived + 1)):
+        grid.update(frame.depth)
+        if frame.index in checks:
+            chair = chair_pixels(scenario, frame, cam)
+            assert chair.sum() > 5000
+            foreground = foreground_from_grid(grid.states, spec, frame.depth[cam.name], cam)
+            share[checks[frame.index], frame.index - drop] = foreground[chair].mean()
+    assert share["carried", -5] > 0.8
+    assert share["resting", derived // 2] > 0.8
+    assert share["resting", derived - 8] > 0.3  # not static before its time
+    assert share["static", derived] < 0.1
+
+
+def test_cells_behind_the_desk_are_hidden():
+    scenario = build_scenario("sit_behind_table", use_mocap=False)
+    start, stop = scenario.events["sitting"]
+    frame = next(frames(scenario, seed=5, indices=[(start + stop) // 2]))
+    knees = frame.joints[0, [JOINT_INDEX["left_knee"], JOINT_INDEX["right_knee"]]]
+    assert not frame.visible[0, [JOINT_INDEX["left_knee"], JOINT_INDEX["right_knee"]]].any()
+    grid = OccupancyGrid(spec_from_cameras(scenario.cameras), scenario.cameras)
+    grid.update(frame.depth)
+    behind_panel = np.array([[x, y, z] for x in (-0.4, 0.0, 0.4) for y in (2.3, 2.6, 2.9) for z in (0.2, 0.4)])
+    assert np.all(grid.visibility_at(knees) == HIDDEN)
+    assert np.all(grid.visibility_at(behind_panel) == HIDDEN)
+    open_room = np.array([[x, y, z] for x in (-0.6, 0.0, 0.6) for y in (1.6, 2.0) for z in (0.8, 1.2, 1.6)])
+    assert np.all(grid.visibility_at(open_room) == VISIBLE)
+    beside_camera = np.array([[2.0, 0.3, 0.5], [-2.0, 0.3, 1.5], [0.0, 20.0, 1.0]])  # outside the view / the grid
+    assert np.all(grid.visibility_at(beside_camera) == UNOBSERVED)
+
+
+def test_a_second_camera_sees_what_the_first_cannot():
+    scenario = build_scenario("two_cameras_occlusion", use_mocap=False)
+    start, stop = scenario.events["sitting"]
+    frame = next(frames(scenario, seed=6, indices=[(start + stop) // 2]))
+    behind_panel = np.array([[x, 2.45, z] for x in (0.25, 0.35) for z in (0.2, 0.3)])
+    front_only = OccupancyGrid(spec_from_cameras(scenario.cameras[:1]), scenario.cameras[:1])
+    front_only.update({"front": frame.depth["front"]})
+    both = OccupancyGrid(spec_from_cameras(scenario.cameras), scenario.cameras)
+    both.update(frame.depth)
+    assert np.all(front_only.visibility_at(behind_panel) == HIDDEN)
+    assert np.all(both.visibility_at(behind_panel) == VISIBLE)  # hidden only if hidden from every camera
