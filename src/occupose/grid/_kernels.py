@@ -65,6 +65,7 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
     """
     num_cameras = rotations.shape[0]
     lut_last = sigma_lut.shape[1] - 1
+    lut_scale = 1.0 / lut_step
     for i in numba.prange(nx):
         x = origin[0] + cell * (i + 0.5)
         column = np.empty((num_cameras, 3))  # camera-frame centre of cell (i, j, k)
@@ -96,7 +97,7 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                     if not (d > 0.0 and d < np.inf):
                         continue
                     covered = True
-                    width = tail_width * sigma_lut[c, min(int(depth_l / lut_step), lut_last)]
+                    width = tail_width * sigma_lut[c, min(int(depth_l * lut_scale), lut_last)]
                     epsilon = d - depth_l
                     f = observation(epsilon, half_extents[c], width, p_occ, p_free)
                     if epsilon >= -(half_extents[c] + TAIL_CUT * width):
@@ -110,10 +111,10 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                 r_o = (q_o * transition[0, 0] + q_m * transition[1, 0] + q_e * transition[2, 0]) * b_occupied
                 r_m = (q_o * transition[0, 1] + q_m * transition[1, 1] + q_e * transition[2, 1]) * b_occupied
                 r_e = (q_o * transition[0, 2] + q_m * transition[1, 2] + q_e * transition[2, 2]) * b_empty
-                total = r_o + r_m + r_e
-                r_o /= total
-                r_m /= total
-                r_e /= total
+                scale = 1.0 / (r_o + r_m + r_e)
+                r_o *= scale
+                r_m *= scale
+                r_e *= scale
                 if r_o < flush:
                     r_o = 0.0
                 if r_m < flush:

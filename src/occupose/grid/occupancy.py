@@ -467,7 +467,8 @@ class OccupancyGrid:
         """The depth noise (one standard deviation, metres) the grid assumes for camera ``camera``
         at depth ``depth_l`` ((...) float, metres), as tabulated in 1 cm steps."""
         c = self._camera_index(camera)
-        m = np.minimum((np.asarray(depth_l, np.float64) / _LUT_STEP).astype(np.int64), self._sigma_lut.shape[1] - 1)
+        m = (np.asarray(depth_l, np.float64) * (1.0 / _LUT_STEP)).astype(np.int64)
+        m = np.minimum(m, self._sigma_lut.shape[1] - 1)
         return self._sigma_lut[c, m]
 
     def half_extent(self, camera: str) -> float:
