@@ -1,0 +1,409 @@
+"""Numba kernels of the likelihoods (private: use the classes of :mod:`occupose.likelihood`).
+
+Every kernel takes the particles' capsules as ``a, b`` (P, C, 3) float64 world metres (the
+two ends of each round cone) with ``radii`` (C, 2) float64 (radius at a, at b) and
+``capsule_part`` (C,) int64, runs in parallel over particles, and adds its result into
+``out`` (P, K) float64, one column per part.
+
+Loop order for speed (measured): particles outer (one per thread), then blocks of nearby
+points, capsules next (nearest first, skipping those that cannot be the nearest of any
+point of the block), the points of the block innermost over separate contiguous x, y, z
+float32 arrays, so that the point loop is branch-free and vectorised (8 float32 lanes with
+AVX2). Points are stored relative to a per-frame ``origin`` (their centroid) to keep
+float32 exact to micrometres.
+
+A round cone whose larger end sphere holds the smaller one (``|b - a| <= |ra - rb|``,
+e.g. a sphere given as ``a == b``) is that larger sphere.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from occupose.synth._kernels import _depth
+from occupose.synth.primitives import ELLIPSOID, ROUND_CONE
+
+# Below this value of |b - a|^2 - (ra - rb)^2 (m^2) a round cone is treated as its larger sphere.
+_DEGENERATE = 1e-12
+
+
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+def _round_cone_distance(px, py, pz, ax, ay, az, ex, ey, ez, length, k, s, g, r1, r2):
+    """Signed distance from point p to a round cone (negative inside), after Inigo Quilez's
+    exact round-cone distance, written in the cone's own units with one square root.
+
+    a : end a; e : unit axis a -> b; length = |b - a|; with rr = r1 - r2, l2 = length^2
+    and a2 = l2 - rr^2 (> 0): k = rr |rr| / a2, s = a2 / l2, g = rr / length.
+    """
+    pax = px - ax
+    pay = py - ay
+    paz = pz - az
+    t = pax * ex + pay * ey + paz * ez  # along the axis from a
+    rho2 = pax * pax + pay * pay + paz * paz - t * t  # squared distance from the axis
+    tb = t - length
+    bound = k * rho2
+    near_b = tb * abs(tb) > bound  # closest to the sphere at b
+    near_a = t * abs(t) < bound  # closest to the sphere at a
+    arg = rho2 + tb * tb if near_b else (rho2 + t * t if near_a else rho2 * s)
+    offset = -r2 if near_b else (-r1 if near_a else t * g - r1)
+    return math.sqrt(arg) + offset
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _capsule_constants(ax, ay, az, bx, by, bz, r1, r2):
+    """The arguments of :func:`_round_cone_distance` after the point, as a tuple of 12
+    floats, for the round cone from (ax, ay, az) radius r1 to (bx, by, bz) radius r2. A
+    degenerate cone comes back as its larger sphere: centre in the ``a`` slot, axis 0,
+    length 0, k = 1 (so that ``near_a`` always holds), radius in r1 and r2.
+    """
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    l2 = dx * dx + dy * dy + dz * dz
+    rr = r1 - r2
+    a2 = l2 - rr * rr
+    if a2 <= _DEGENERATE:
+        if r2 > r1:
+            return bx, by, bz, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, r2, r2
+        return ax, ay, az, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, r1, r1
+    length = math.sqrt(l2)
+    return ax, ay, az, dx / length, dy / length, dz / length, length, rr * abs(rr) / a2, a2 / l2, rr / length, r1, r2
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius, best, arg):
+    """For each point i: ``best[i]`` = min over capsules of |signed distance| (float32,
+    metres) and ``arg[i]`` the capsule that attains it, for particle ``p``.
+
+    The points come in spatially compact blocks (block b holds points block_start[b] to
+    block_start[b + 1] - 1, within block_radius[b] of block_centre[:, b], all minus origin).
+    As the distance is 1-Lipschitz, no point of block b is nearer than |d(centre)| - radius
+    to a capsule, so each block visits the capsules in order of that bound and stops at the
+    first whose bound exceeds the block's worst distance so far: the result is the
+    exhaustive one (up to float32 rounding on near-ties), in a fraction of the time.
+    """
+    num_capsules = a.shape[1]
+    consts = np.empty((num_capsules, 12))
+    for c in range(num_capsules):
+        values = _capsule_constants(
+            a[p, c, 0] - origin[0], a[p, c, 1] - origin[1], a[p, c, 2] - origin[2],
+            b[p, c, 0] - origin[0], b[p, c, 1] - origin[1], b[p, c, 2] - origin[2], radii[c, 0], radii[c, 1])
+        for j in range(12):
+            consts[c, j] = values[j]
+    num_blocks = block_start.shape[0] - 1
+    bounds = np.empty((num_capsules, num_blocks))
+    for c in range(num_capsules):  # vectorised over blocks
+        ax, ay, az, ex, ey, ez = consts[c, 0], consts[c, 1], consts[c, 2], consts[c, 3], consts[c, 4], consts[c, 5]
+        length, k, s, g, r1, r2 = consts[c, 6], consts[c, 7], consts[c, 8], consts[c, 9], consts[c, 10], consts[c, 11]
+        for block in range(num_blocks):
+            bounds[c, block] = abs(_round_cone_distance(block_centre[0, block], block_centre[1, block],
+                                                        block_centre[2, block], ax, ay, az, ex, ey, ez, length, k,
+                                                        s, g, r1, r2)) - block_radius[block]
+    bound = np.empty(num_capsules)
+    order = np.empty(num_capsules, np.int64)
+    best_bits = best.view(np.int32)
+    scratch = np.empty(1, np.float32)
+    scratch_bits = scratch.view(np.int32)
+    f = np.float32
+    # Unsigned loop bounds and no array views in the loops: a signed start makes numba guard
+    # every index against wraparound, and views cost reference counting, both of which
+    # keep the point loop from vectorising or dominate it.
+    for block in range(num_blocks):
+        lo, hi = np.uint64(block_start[block]), np.uint64(block_start[block + 1])
+        for c in range(num_capsules):  # insertion sort of the capsules by their bound
+            value = bounds[c, block]
+            j = c
+            while j > 0 and bound[j - 1] > value:
+                bound[j] = bound[j - 1]
+                order[j] = order[j - 1]
+                j -= 1
+            bound[j] = value
+            order[j] = c
+        for i in range(lo, hi):
+            best[i] = np.inf
+            arg[i] = 0
+        worst = np.inf
+        for j in range(num_capsules):
+            if bound[j] >= worst:
+                break
+            c = order[j]
+            ax, ay, az = f(consts[c, 0]), f(consts[c, 1]), f(consts[c, 2])
+            ex, ey, ez = f(consts[c, 3]), f(consts[c, 4]), f(consts[c, 5])
+            length, k, s, g = f(consts[c, 6]), f(consts[c, 7]), f(consts[c, 8]), f(consts[c, 9])
+            r1, r2 = f(consts[c, 10]), f(consts[c, 11])
+            cc = np.int32(c)
+            for i in range(lo, hi):
+                d = abs(_round_cone_distance(px[i], py[i], pz[i], ax, ay, az, ex, ey, ez, length, k, s, g, r1, r2))
+                current = best[i]
+                arg[i] = cc if d < current else arg[i]
+                best[i] = min(d, current)
+            # The block's largest distance: a max over the float32 bit patterns (ordered as the
+            # non-negative floats they encode), which vectorises where a float max does not.
+            top = np.int32(0)
+            for i in range(lo, hi):
+                top = max(top, best_bits[i])
+            scratch_bits[0] = top
+            worst = scratch[0]
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def nearest_capsules(a, b, radii, origin, px, py, pz, weight, block_start, block_centre, block_radius, distance,
+                     capsule):
+    """Each point's distance to the nearest capsule surface and that capsule, per particle.
+
+    origin : (3,) float64; px, py, pz : (M,) float32, points minus origin, in blocks
+    (block_start (B + 1,) int64, block_centre (3, B) float64 minus origin, block_radius
+    (B,) float64; see :func:`_nearest_capsules`); weight : (M,) float32, unused here;
+    distance : (P, M) float32 out, metres; capsule : (P, M) int32 out.
+    """
+    for p in numba.prange(a.shape[0]):
+        _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius,
+                          distance[p], capsule[p])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=True)
+def _capsule_sum(best, weight, arg, c):
+    """sum of weight * best over the entries with arg == c (float64; fastmath lets the sum
+    vectorise, which is faster than adding each point to its part's total in turn)."""
+    total = 0.0
+    for i in range(best.shape[0]):
+        total += weight[i] * best[i] if arg[i] == c else np.float32(0.0)
+    return total
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def point_distance_sums(a, b, radii, capsule_part, origin, px, py, pz, weight, block_start, block_centre,
+                        block_radius, out):
+    """out[p, k] += sum of weight * distance over the points whose nearest capsule belongs to
+    part k. Arguments as :func:`nearest_capsules`; out : (P, K) float64.
+    """
+    n = px.shape[0]
+    for p in numba.prange(a.shape[0]):
+        best = np.empty(n, np.float32)
+        arg = np.empty(n, np.int32)
+        _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius, best, arg)
+        for c in range(a.shape[1]):
+            out[p, capsule_part[c]] += _capsule_sum(best, weight, arg, np.int32(c))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samples):
+    """Write the camera-facing samples of capsule ``c`` of particle ``p`` into ``samples``
+    (2 + T * A, 3), world metres: first the point of each end sphere nearest the camera
+    centre ``eye`` (the sphere's centre when the camera is inside it), then for each axis
+    fraction ``along[j]`` the points at the angles (cos_around, sin_around) about the axis,
+    from the direction facing the camera, on the circle of radius lerp(ra, rb, t) about
+    lerp(a, b, t). Every sample lies in the round cone.
+    """
+    ra, rb = radii[c, 0], radii[c, 1]
+    for end in range(2):
+        r = ra if end == 0 else rb
+        for i in range(3):
+            samples[end, i] = a[p, c, i] if end == 0 else b[p, c, i]
+        wx, wy, wz = eye[0] - samples[end, 0], eye[1] - samples[end, 1], eye[2] - samples[end, 2]
+        norm = math.sqrt(wx * wx + wy * wy + wz * wz)
+        if norm > r:
+            samples[end, 0] += r * wx / norm
+            samples[end, 1] += r * wy / norm
+            samples[end, 2] += r * wz / norm
+    ex, ey, ez = b[p, c, 0] - a[p, c, 0], b[p, c, 1] - a[p, c, 1], b[p, c, 2] - a[p, c, 2]
+    length = math.sqrt(ex * ex + ey * ey + ez * ez)
+    if length > 0.0:
+        ex, ey, ez = ex / length, ey / length, ez / length
+    else:
+        ex, ey, ez = 0.0, 0.0, 1.0
+    s = 2
+    for j in range(along.shape[0]):
+        t = along[j]
+        ox = a[p, c, 0] + t * (b[p, c, 0] - a[p, c, 0])
+        oy = a[p, c, 1] + t * (b[p, c, 1] - a[p, c, 1])
+        oz = a[p, c, 2] + t * (b[p, c, 2] - a[p, c, 2])
+        r = ra + t * (rb - ra)
+        # n: towards the camera, square to the axis; m = e x n completes the frame.
+        wx, wy, wz = eye[0] - ox, eye[1] - oy, eye[2] - oz
+        dot = wx * ex + wy * ey + wz * ez
+        nx, ny, nz = wx - dot * ex, wy - dot * ey, wz - dot * ez
+        norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+        if norm < 1e-9:  # camera on the axis: any square direction
+            nx, ny, nz = (1.0, 0.0, 0.0) if abs(ex) < 0.9 else (0.0, 1.0, 0.0)
+            dot = nx * ex + ny * ey + nz * ez
+            nx, ny, nz = nx - dot * ex, ny - dot * ey, nz - dot * ez
+            norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+        nx, ny, nz = nx / norm, ny / norm, nz / norm
+        mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
+        for i in range(cos_around.shape[0]):
+            co, si = r * cos_around[i], r * sin_around[i]
+            samples[s, 0] = ox + co * nx + si * mx
+            samples[s, 1] = oy + co * ny + si * my
+            samples[s, 2] = oz + co * nz + si * mz
+            s += 1
+
+
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+def _pixel(x, y, z, rotation, shift, fx, fy, cx, cy, height, width):
+    """Nearest pixel (v, u) and camera z of world point (x, y, z); v = -1 when it is behind
+    the camera or outside the height x width image."""
+    xc = rotation[0, 0] * x + rotation[0, 1] * y + rotation[0, 2] * z + shift[0]
+    yc = rotation[1, 0] * x + rotation[1, 1] * y + rotation[1, 2] * z + shift[1]
+    zc = rotation[2, 0] * x + rotation[2, 1] * y + rotation[2, 2] * z + shift[2]
+    if zc <= 0.0:
+        return -1, -1, zc
+    u = math.floor(fx * xc / zc + cx + 0.5)
+    v = math.floor(fy * yc / zc + cy + 0.5)
+    if u < 0 or v < 0 or u >= width or v >= height:
+        return -1, -1, zc
+    return int(v), int(u), zc
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def free_space_penalties(a, b, radii, capsule_part, rotation, shift, eye, fx, fy, cx, cy, free_depth,
+                         along, cos_around, sin_around, ramp, out):
+    """out[p, k] += sum over part k's surface samples of their free-space penalty in one view.
+
+    rotation (3, 3), shift (3,) : camera_from_world; eye : (3,) the camera centre, world;
+    fx, fy, cx, cy : intrinsics (pixels); free_depth : (H, W) float32, metres, the depth
+    beyond which space is seen empty (measured depth minus the margin; 0 where nothing
+    was measured, which never penalises); along, cos_around, sin_around : the samples of
+    :func:`_surface_samples`; ramp : metres. A sample in the image whose pixel's free
+    depth f exceeds its camera depth zc costs min((f - zc) / ramp, 1).
+    """
+    height, width = free_depth.shape
+    num_samples = 2 + along.shape[0] * cos_around.shape[0]
+    for p in numba.prange(a.shape[0]):
+        samples = np.empty((num_samples, 3))
+        for c in range(a.shape[1]):
+            _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samples)
+            total = 0.0
+            for s in range(num_samples):
+                v, u, zc = _pixel(samples[s, 0], samples[s, 1], samples[s, 2], rotation, shift, fx, fy, cx, cy,
+                                  height, width)
+                if v >= 0:
+                    excess = free_depth[v, u] - zc
+                    if excess > 0.0:
+                        total += min(excess / ramp, 1.0)
+            out[p, capsule_part[c]] += total
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def color_counts(a, b, radii, capsule_part, rotation, shift, eye, fx, fy, cx, cy, hidden_depth, cells,
+                 along, cos_around, sin_around, counts):
+    """counts[p, k, j] += how many of part k's surface samples land on a pixel of colour cell j.
+
+    Arguments as :func:`free_space_penalties`; hidden_depth : (H, W) float32, metres, the
+    depth beyond which a sample is hidden by what was measured at its pixel (0 = no
+    measurement: never hidden); cells : (H, W) int64, each pixel's colour cell, -1 for
+    none; counts : (P, K, B) float64. A sample counts when it is in the image, on a pixel
+    with a colour cell, and not hidden (zc <= hidden depth): the pixel shows either the
+    part or, where the part is misplaced, whatever lies behind it.
+    """
+    height, width = cells.shape
+    num_samples = 2 + along.shape[0] * cos_around.shape[0]
+    for p in numba.prange(a.shape[0]):
+        samples = np.empty((num_samples, 3))
+        for c in range(a.shape[1]):
+            _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samples)
+            k = capsule_part[c]
+            for s in range(num_samples):
+                v, u, zc = _pixel(samples[s, 0], samples[s, 1], samples[s, 2], rotation, shift, fx, fy, cx, cy,
+                                  height, width)
+                if v >= 0 and cells[v, u] >= 0:
+                    hidden = hidden_depth[v, u]
+                    if hidden == 0.0 or zc <= hidden:
+                        counts[p, k, cells[v, u]] += 1.0
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def render_sigmas(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, u0, v0, stride, observed,
+                  truncation, out):
+    """out[p, k] += the first paper's sigma over a pixel grid of one view, split by part.
+
+    rotation (3, 3), shift (3,) : camera_from_world; fx, fy, cx, cy : intrinsics (pixels);
+    the grid's pixel (gv, gu) is image pixel (v0 + stride gv, u0 + stride gu);
+    observed : (Gv, Gu) float64, metres, the observed depth where the pixel is in the
+    person's silhouette, else 0; truncation : D, metres.
+
+    Each particle's capsules are ray-cast (exact hits, nearest camera z) into the grid
+    pixels of their screen rectangles. A pixel in both silhouettes adds
+    min(|d_obs - d_model| / D, 1)^2 to the part rendered there; a pixel of the model only
+    adds 1 to the part rendered there; a pixel of the observation only adds 1 to the part
+    of the capsule nearest (|signed distance|) its back-projected 3D point.
+    """
+    num_v, num_u = observed.shape
+    num_capsules = a.shape[1]
+    for p in numba.prange(a.shape[0]):
+        kinds = np.empty(num_capsules, np.int8)
+        params = np.zeros((num_capsules, 16))
+        consts = np.empty((num_capsules, 12))
+        zbuf = np.full((num_v, num_u), np.inf)
+        winner = np.full((num_v, num_u), -1, np.int64)
+        for c in range(num_capsules):
+            # Capsule ends in the camera frame.
+            for end in range(2):
+                x = a[p, c, 0] if end == 0 else b[p, c, 0]
+                y = a[p, c, 1] if end == 0 else b[p, c, 1]
+                z = a[p, c, 2] if end == 0 else b[p, c, 2]
+                for i in range(3):
+                    params[c, 3 * end + i] = rotation[i, 0] * x + rotation[i, 1] * y + rotation[i, 2] * z + shift[i]
+            params[c, 6], params[c, 7] = radii[c, 0], radii[c, 1]
+            values = _capsule_constants(params[c, 0], params[c, 1], params[c, 2], params[c, 3], params[c, 4],
+                                        params[c, 5], params[c, 6], params[c, 7])
+            for i in range(12):
+                consts[c, i] = values[i]
+            # Screen rectangle from the two end spheres' bounding boxes.
+            lo_x, hi_x, lo_y, hi_y = np.inf, -np.inf, np.inf, -np.inf
+            behind = False
+            for end in range(2):
+                x, y, z = params[c, 3 * end], params[c, 3 * end + 1], params[c, 3 * end + 2]
+                r = radii[c, end]
+                if z - r <= 1e-6:
+                    behind = True
+                    break
+                for zz in (z - r, z + r):
+                    lo_x = min(lo_x, (x - r) / zz)
+                    hi_x = max(hi_x, (x + r) / zz)
+                    lo_y = min(lo_y, (y - r) / zz)
+                    hi_y = max(hi_y, (y + r) / zz)
+            if behind:
+                gu0, gu1, gv0, gv1 = 0, num_u - 1, 0, num_v - 1
+            else:
+                gu0 = max(int(math.ceil((fx * lo_x + cx - u0) / stride)), 0)
+                gu1 = min(int(math.floor((fx * hi_x + cx - u0) / stride)), num_u - 1)
+                gv0 = max(int(math.ceil((fy * lo_y + cy - v0) / stride)), 0)
+                gv1 = min(int(math.floor((fy * hi_y + cy - v0) / stride)), num_v - 1)
+            kinds[c] = ROUND_CONE
+            if consts[c, 6] == 0.0:  # degenerate: the larger sphere, cast as a unit-sphere ellipsoid
+                kinds[c] = ELLIPSOID
+                r = consts[c, 10]
+                params[c, 0:3] = -consts[c, 0:3] / r
+                params[c, 3:12] = 0.0
+                params[c, 3] = params[c, 7] = params[c, 11] = 1.0 / r
+            for gv in range(gv0, gv1 + 1):
+                ray_y = (v0 + stride * gv - cy) / fy
+                for gu in range(gu0, gu1 + 1):
+                    depth = _depth(kinds[c], params, c, (u0 + stride * gu - cx) / fx, ray_y)
+                    if 0.0 < depth < zbuf[gv, gu]:
+                        zbuf[gv, gu] = depth
+                        winner[gv, gu] = c
+        for gv in range(num_v):
+            ray_y = (v0 + stride * gv - cy) / fy
+            for gu in range(num_u):
+                d_obs = observed[gv, gu]
+                c = winner[gv, gu]
+                if c >= 0:
+                    if d_obs > 0.0:
+                        f = min(abs(d_obs - zbuf[gv, gu]) / truncation, 1.0)
+                        out[p, capsule_part[c]] += f * f
+                    else:
+                        out[p, capsule_part[c]] += 1.0
+                elif d_obs > 0.0:
+                    qx, qy, qz = (u0 + stride * gu - cx) / fx * d_obs, ray_y * d_obs, d_obs
+                    nearest, best = 0, np.inf
+                    for k in range(num_capsules):
+                        d = abs(_round_cone_distance(qx, qy, qz, consts[k, 0], consts[k, 1], consts[k, 2],
+                                                     consts[k, 3], consts[k, 4], consts[k, 5], consts[k, 6],
+                                                     consts[k, 7], consts[k, 8], consts[k, 9], consts[k, 10],
+                                                     consts[k, 11]))
+                        if d < best:
+                            nearest, best = k, d
+                    out[p, capsule_part[nearest]] += 1.0

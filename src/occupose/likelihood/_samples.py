@@ -1,0 +1,39 @@
+"""Shared set-up of the terms that project capsule surface samples into the views (private)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from occupose.synth.noise import depth_std
+
+#: Angles of the samples about a capsule's axis, either side of the camera-facing direction,
+#: degrees: 45 keeps them inside the silhouette of a limb whose model is up to ~40 % too thick.
+SAMPLE_SPAN_DEGREES = 45.0
+
+
+def sample_pattern(samples_along, samples_around):
+    """Check the sample counts; return along (T,), cos_around (A,), sin_around (A,) float64
+    (see occupose.likelihood._kernels._surface_samples) and the samples per capsule, 2 + T A."""
+    for name, count in (("samples_along", samples_along), ("samples_around", samples_around)):
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+            raise ValueError(f"{name} must be a positive integer, got {count!r}")
+    along = (np.arange(samples_along) + 0.5) / samples_along
+    angles = np.radians(np.linspace(-SAMPLE_SPAN_DEGREES, SAMPLE_SPAN_DEGREES, samples_around)
+                        if samples_around > 1 else np.zeros(1))
+    return along, np.cos(angles), np.sin(angles), 2 + int(samples_along) * int(samples_around)
+
+
+def depth_tolerance(depth: np.ndarray, margin: float, noise: str) -> np.ndarray:
+    """(H, W) float64 metres: ``margin`` + 3 sigma of the ``noise`` model's random error at
+    each measured depth (0 where depth is 0)."""
+    margin = float(margin)
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ValueError(f"margin must be a finite number >= 0 metres, got {margin!r}")
+    depth = depth.astype(np.float64)
+    return np.where(depth > 0, margin + 3.0 * depth_std(depth, noise), 0.0)
+
+
+def camera_arrays(camera):
+    """rotation (3, 3) and shift (3,) of camera_from_world, and the camera centre (3,), world."""
+    pose = camera.camera_from_world
+    return np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3]), camera.position

@@ -1,0 +1,438 @@
+"""Likelihood kernels against slow NumPy references, and the likelihoods on synthetic frames."""
+
+import numpy as np
+import pytest
+
+from occupose.body import BODY_MODELS, capsules_from_poses, pose_from_joints
+from occupose.camera import Camera, camera_preset, look_at, pixels_from_points
+from occupose.likelihood import (
+    LIKELIHOODS, ColorLikelihood, FreeSpaceLikelihood, Observation, PointsLikelihood, RenderLikelihood, View,
+    make_likelihood, observation_from_views, point_distances, roi_from_mask, sum_of,
+)
+from occupose.likelihood.color import color_cells
+from occupose.synth import motion as pm
+from occupose.synth import scene
+from occupose.synth.body import primitives_from_joints, random_body_shape
+from occupose.synth.primitives import concat, round_cone
+from occupose.synth.render import render, render_camera
+
+FULL = BODY_MODELS["full"]
+UPPER = BODY_MODELS["upper"]
+
+
+# --- NumPy references ----------------------------------------------------------------------
+
+def _signed_distances(points, a, b, ra, rb):
+    """(N,) signed distance of points to the round cone a-b: the round cone is the union of
+    the balls lerp(a, b, s) of radius lerp(ra, rb, s), so take the minimum over a fine s grid."""
+    s = np.linspace(0.0, 1.0, 4001)
+    centres = a + s[:, None] * (b - a)
+    radius = ra + s * (rb - ra)
+    return (np.linalg.norm(points[:, None, :] - centres[None], axis=2) - radius).min(axis=1)
+
+
+def _capsule_distances(points, a, b, radii):
+    """(P, N, C) absolute distance of each point to each capsule, by brute force."""
+    return np.abs(np.stack([np.stack([_signed_distances(points, a[p, c], b[p, c], *radii[c])
+                                      for c in range(a.shape[1])], axis=1) for p in range(a.shape[0])]))
+
+
+def _nearest_reference(points, a, b, radii):
+    """distance (P, N), capsule (P, N) by brute force."""
+    dist = _capsule_distances(points, a, b, radii)
+    return dist.min(axis=2), dist.argmin(axis=2)
+
+
+def _random_capsules(rng, num_particles=3, num_capsules=5):
+    a = rng.normal(size=(num_particles, num_capsules, 3)) * 0.4 + [0.0, 0.0, 1.0]
+    b = a + rng.normal(size=a.shape) * 0.25
+    radii = rng.uniform(0.03, 0.12, (num_capsules, 2))
+    b[0, 0] = a[0, 0]  # a sphere given as a == b
+    b[1, 1] = a[1, 1] + [0.01, 0.0, 0.0]  # end b inside the sphere at a: that sphere
+    radii[1] = (0.10, 0.05)
+    return a, b, radii
+
+
+def _model_capsules(model, poses):
+    a, b = capsules_from_poses(model, np.atleast_2d(poses))
+    return a, b, model.capsule_radii, model.capsule_part, model.num_parts
+
+
+# --- synthetic frames --------------------------------------------------------------------
+
+FRONT_EYE = (3.0, 0.0, 1.4)
+
+
+def _front_camera(eye=FRONT_EYE):
+    return camera_preset("kinect_v1", world_from_camera=look_at(eye, (0.0, 0.0, 0.9)))
+
+
+def _frame(joints, static=None, camera=None, seed=0, clothing="normal"):
+    """Observation of one person rendered with occupose.synth (noise-free), mask = their pixels."""
+    camera = _front_camera() if camera is None else camera
+    body = primitives_from_joints(joints, random_body_shape(np.random.default_rng(seed), clothing), 1)
+    rendered = render_camera(body if static is None else concat([static, body]), camera)
+    return observation_from_views([View(camera, rendered.depth, rendered.person == 1, rendered.color)])
+
+
+ARMS_OUT = dict(right_shoulder_flex=0.6, right_elbow=0.8, left_shoulder_abd=0.5)
+
+
+@pytest.fixture(scope="module")
+def front():
+    """A person facing a Kinect 3 m away in an empty room: observation, the fitted true pose."""
+    joints = pm.joints_from_pose(pm.pose_with(pm.standing_pose(), **ARMS_OUT))
+    return _frame(joints, static=scene.room(walls=("-x",))), pose_from_joints(FULL, joints)
+
+
+def _perturbed(model, pose, dofs, delta_angle=0.25, delta_metres=0.05):
+    """The pose, then each named DOF moved by -delta and +delta within its limits (moves
+    that the limits cancel are left out): (1 + up to 2 len(dofs), D)."""
+    poses = [pose]
+    for name in dofs:
+        i = model.dof(name)
+        for sign in (-1.0, 1.0):
+            moved = pose.copy()
+            moved[i] = np.clip(pose[i] + sign * (delta_angle if model.angular[i] else delta_metres), *model.limits[i])
+            if abs(moved[i] - pose[i]) > 0.5 * (delta_angle if model.angular[i] else delta_metres):
+                poses.append(moved)
+    return np.array(poses)
+
+
+FULL_DOFS = ("x", "y", "z", "heading", "trunk_lean", "neck_flex", "left_shoulder_flex", "left_shoulder_abd",
+             "left_elbow", "right_shoulder_flex", "right_shoulder_abd", "right_elbow", "left_hip_flex",
+             "right_hip_flex", "left_knee", "right_knee")
+
+
+# --- kernels against NumPy references ------------------------------------------------------
+
+def test_point_distances_match_brute_force(rng):
+    a, b, radii = _random_capsules(rng)
+    points = rng.normal(size=(300, 3)) * 0.5 + [0.0, 0.0, 1.0]
+    points[:20] = a[0, 2] + rng.normal(size=(20, 3)) * 0.03  # some inside a capsule
+    distance, capsule = point_distances(a, b, radii, points)
+    every = _capsule_distances(points, a, b, radii)
+    assert distance.dtype == np.float32 and capsule.shape == (3, 300)
+    np.testing.assert_allclose(distance, every.min(axis=2), atol=2e-6)
+    assert np.mean(capsule == every.argmin(axis=2)) > 0.99  # near-ties within float32 may differ
+    chosen = np.take_along_axis(every, capsule[..., None].astype(int), axis=2)[..., 0]
+    np.testing.assert_allclose(chosen, every.min(axis=2), atol=2e-6)
+
+
+def test_points_likelihood_matches_reference(rng):
+    a, b, radii = _random_capsules(rng)
+    part = np.array([0, 2, 1, 2, 0])
+    points = rng.normal(size=(250, 3)) * 0.5 + [0.0, 0.0, 1.0]
+    obs = Observation(points, ())
+    got = PointsLikelihood(obs, scale=0.05).evaluate(a, b, radii, part, 4)
+    distance, capsule = _nearest_reference(points, a, b, radii)
+    want = np.zeros((3, 4))
+    for p in range(3):
+        np.add.at(want[p], part[capsule[p]], distance[p])
+    want *= -1.0 / (250 * 0.05)
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    np.testing.assert_allclose(got.sum(axis=1), -distance.mean(axis=1) / 0.05, atol=1e-6)
+    assert np.all(got[:, 3] == 0.0)  # no capsule in part 3
+
+
+def _samples_reference(a, b, radii, eye, along, around):
+    """(2 + along * around, 3) camera-facing samples of one capsule a-b, by NumPy vector algebra."""
+    ends = np.array([a, b])
+    to_eye = eye - ends
+    caps = ends + radii[:, None] * to_eye / np.linalg.norm(to_eye, axis=1, keepdims=True)
+    t = (np.arange(along) + 0.5) / along
+    phi = np.radians(np.linspace(-45, 45, around))
+    e = (b - a) / np.linalg.norm(b - a)
+    centres = a + t[:, None] * (b - a)
+    r = radii[0] + t * (radii[1] - radii[0])
+    w = eye - centres
+    n = w - (w @ e)[:, None] * e
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    m = np.cross(e, n)
+    ring = centres[:, None] + r[:, None, None] * (np.cos(phi)[None, :, None] * n[:, None]
+                                                  + np.sin(phi)[None, :, None] * m[:, None])
+    return np.concatenate([caps, ring.reshape(-1, 3)])
+
+
+def _sample_pixels(samples, cam):
+    """Rounded pixels (v, u), camera z and in-image flags of world samples."""
+    uv, z = pixels_from_points(samples, cam)
+    u, v = np.floor(uv[:, 0] + 0.5).astype(int), np.floor(uv[:, 1] + 0.5).astype(int)
+    ok = (z > 0) & (u >= 0) & (v >= 0) & (u < cam.width) & (v < cam.height)
+    return v, u, z, ok
+
+
+def _free_reference(a, b, radii, part, num_parts, view, tolerance, ramp, along, around):
+    """Mean free-space penalty per part."""
+    free = np.where(view.depth > 0, view.depth - tolerance(view.depth), 0.0)
+    out = np.zeros((a.shape[0], num_parts))
+    count = np.zeros(num_parts)
+    for p in range(a.shape[0]):
+        for c in range(a.shape[1]):
+            v, u, z, ok = _sample_pixels(_samples_reference(a[p, c], b[p, c], radii[c], view.camera.position,
+                                                            along, around), view.camera)
+            out[p, part[c]] += np.clip((free[v[ok], u[ok]] - z[ok]) / ramp, 0.0, 1.0).sum()
+            count[part[c]] += (along * around + 2) / a.shape[0]
+    return out / np.maximum(count, 1)
+
+
+def _color_reference(a, b, radii, part, num_parts, view, tolerance, bins, along, around):
+    """Normalised colour histograms (P, K, bins^3) of the samples not hidden."""
+    hidden = np.where(view.depth > 0, view.depth + tolerance(view.depth), np.inf)
+    cells = color_cells(view.color, bins)
+    out = np.zeros((a.shape[0], num_parts, bins ** 3))
+    for p in range(a.shape[0]):
+        for c in range(a.shape[1]):
+            v, u, z, ok = _sample_pixels(_samples_reference(a[p, c], b[p, c], radii[c], view.camera.position,
+                                                            along, around), view.camera)
+            shown = ok.copy()
+            shown[ok] = z[ok] <= hidden[v[ok], u[ok]]
+            np.add.at(out[p, part[c]], cells[v[shown], u[shown]], 1.0)
+    total = out.sum(axis=2, keepdims=True)
+    return np.divide(out, total, out=np.zeros_like(out), where=total > 0)
+
+
+def _test_view(rng, color=False):
+    """An 80 x 60 view of random depths (20 % missing) and colours."""
+    camera = Camera("c", 80, 60, 60.0, 60.0, 39.5, 29.5, world_from_camera=look_at((3, 0.2, 1.2), (0, 0, 1)))
+    depth = rng.uniform(1.5, 4.5, (60, 80)).astype(np.float32)
+    depth[rng.random((60, 80)) < 0.2] = 0.0
+    image = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8) if color else None
+    return View(camera, depth, np.zeros((60, 80), bool), image)
+
+
+def _test_capsules(rng):
+    a = rng.normal(size=(4, 3, 3)) * 0.3 + [0.0, 0.0, 1.0]
+    b = a + rng.normal(size=a.shape) * 0.3
+    return a, b, rng.uniform(0.04, 0.12, (3, 2)), np.array([1, 0, 1])
+
+
+def test_free_space_matches_reference(rng):
+    from occupose.synth.noise import depth_std
+
+    view = _test_view(rng)
+    a, b, radii, part = _test_capsules(rng)
+    got = FreeSpaceLikelihood(Observation(np.zeros((1, 3)), (view,)), weight=2.0, margin=0.02, ramp=0.1,
+                              noise="tof", samples_along=3, samples_around=4).evaluate(a, b, radii, part, 3)
+    want = _free_reference(a, b, radii, part, 3, view, lambda d: 0.02 + 3 * depth_std(d, "tof"), 0.1, 3, 4)
+    np.testing.assert_allclose(got, -2.0 * want, atol=1e-6)
+    assert np.any(want > 0.05) and np.all(got[:, 2] == 0.0)
+
+
+def test_color_matches_reference(rng):
+    from occupose.synth.noise import depth_std
+
+    view = _test_view(rng, color=True)
+    a, b, radii, part = _test_capsules(rng)
+    obs = Observation(np.zeros((1, 3)), (view,))
+    like = ColorLikelihood(obs, bins=3, scale=2.0, margin=0.1, noise="tof", samples_along=4, samples_around=3)
+    hist = like.histograms(a, b, radii, part, 3)
+    want = _color_reference(a, b, radii, part, 3, view, lambda d: 0.1 + 3 * depth_std(d, "tof"), 3, 4, 3)
+    np.testing.assert_allclose(hist, want, atol=1e-12)
+    assert np.all(hist[:, 2] == 0.0) and np.all(hist[:, :2].sum(axis=2) > 0.99)
+
+    reference = rng.random((3, 27))
+    reference[1] = 0.0  # part 1 has no reference: scores 0
+    like.set_reference(reference)
+    got = like.evaluate(a, b, radii, part, 3)
+    r = reference / np.maximum(reference.sum(axis=1, keepdims=True), 1e-300)
+    want_d = np.sqrt(np.clip(1 - np.sum(np.sqrt(want * r[None]), axis=2), 0, None))
+    want_d[want.sum(axis=2) == 0] = 1.0  # part 2 has no capsule: distance 1
+    np.testing.assert_allclose(got, -2.0 * want_d * [1, 0, 1], atol=1e-9)
+    like.set_reference(hist[1])  # particle 1's own histograms: distance 0 for its parts
+    np.testing.assert_allclose(like.evaluate(a[1:2], b[1:2], radii, part, 3)[0, :2], 0.0, atol=1e-6)
+
+
+def _render_reference(a, b, radii, part, num_parts, view, stride, truncation):
+    """sigma per part from the synthetic renderer's full images of each particle's capsules."""
+    cam = view.camera
+    v0, v1, u0, u1 = view.roi
+    rows, cols = np.arange(v0, v1, stride), np.arange(u0, u1, stride)
+    observed = np.where(view.mask, view.depth, 0.0)[np.ix_(rows, cols)]
+    out = np.zeros((a.shape[0], num_parts))
+    for p in range(a.shape[0]):
+        prims = concat([round_cone(a[p, c], b[p, c], *radii[c], (200, 200, 200), person=1, part=c + 1)
+                        for c in range(a.shape[1])])
+        rendered = render(prims, cam.width, cam.height, cam.fx, cam.fy, cam.cx, cam.cy, cam.world_from_camera)
+        model = rendered.depth[np.ix_(rows, cols)].astype(np.float64)
+        label = rendered.part[np.ix_(rows, cols)].astype(int) - 1
+        both = (model > 0) & (observed > 0)
+        f = np.minimum(np.abs(observed - model) / truncation, 1.0)
+        np.add.at(out[p], part[label[both]], f[both] ** 2)
+        np.add.at(out[p], part[label[(model > 0) & ~both]], 1.0)
+        only = (observed > 0) & (model == 0)
+        gv, gu = np.nonzero(only)
+        z = observed[gv, gu]
+        points_cam = np.stack([(cols[gu] - cam.cx) / cam.fx * z, (rows[gv] - cam.cy) / cam.fy * z, z], axis=1)
+        points = points_cam @ cam.world_from_camera[:3, :3].T + cam.world_from_camera[:3, 3]
+        _, nearest = _nearest_reference(points, a[p:p + 1], b[p:p + 1], radii)
+        np.add.at(out[p], part[nearest[0]], 1.0)
+    return out, np.count_nonzero(observed)
+
+
+def test_render_matches_reference(rng):
+    camera = Camera("c", 120, 100, 100.0, 100.0, 59.5, 49.5, world_from_camera=look_at((3, 0.3, 1.0), (0, 0, 1)))
+    a = rng.normal(size=(3, 4, 3)) * [0.15, 0.15, 0.3] + [0.0, 0.0, 1.0]
+    b = a + rng.normal(size=a.shape) * 0.2
+    radii = rng.uniform(0.05, 0.12, (4, 2))
+    b[0, 0] = a[0, 0]  # a sphere
+    part = np.array([0, 1, 1, 2])
+    depth = rng.uniform(2.5, 3.3, (100, 120)).astype(np.float32)
+    mask = np.zeros((100, 120), bool)
+    mask[20:80, 40:75] = True
+    view = View(camera, depth, mask, roi=(5, 97, 10, 110))
+    like = RenderLikelihood(Observation(np.zeros((1, 3)), (view,)), scale=3.0, truncation=0.2, stride=3)
+    got = like.evaluate(a, b, radii, part, 3)
+    want, num_observed = _render_reference(a, b, radii, part, 3, view, 3, 0.2)
+    assert like.num_observed == num_observed > 0
+    np.testing.assert_allclose(got, -3.0 * want / num_observed, rtol=1e-5, atol=1e-9)
+    assert np.all(want.sum(axis=1) > 0)
+
+
+# --- the likelihoods on synthetic frames ------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["points", "points+free", "render"])
+def test_true_pose_scores_best(front, name):
+    obs, pose = front
+    poses = _perturbed(FULL, pose, FULL_DOFS)
+    total = make_likelihood(name, obs).evaluate(*_model_capsules(FULL, poses)).sum(axis=1)
+    assert np.argmax(total) == 0 and np.sort(total)[-2] < total[0], (name, total[0], np.sort(total)[-2])
+
+
+def test_color_true_pose_scores_best():
+    """Reference histograms from the estimate of the frame before; flashy clothes (one colour per part)."""
+    joints = pm.joints_from_pose(np.array([pm.pose_with(pm.standing_pose(), right_shoulder_flex=f, left_elbow=e)
+                                           for f, e in ((0.5, 0.6), (0.6, 0.8))]))
+    room = scene.room(walls=("-x",))
+    before = _frame(joints[0], room, clothing="flashy", seed=2)
+    now = _frame(joints[1], room, clothing="flashy", seed=2)
+    like = ColorLikelihood(now)
+    like.set_reference(ColorLikelihood(before).histograms(*_model_capsules(FULL, pose_from_joints(FULL, joints[0])))[0])
+    poses = _perturbed(FULL, pose_from_joints(FULL, joints[1]), FULL_DOFS, delta_angle=0.4, delta_metres=0.1)
+    total = like.evaluate(*_model_capsules(FULL, poses)).sum(axis=1)
+    # colour is blind to moves within a uniformly coloured region, so ties are allowed
+    assert total[0] >= total.max() - 1e-9
+    assert total[0] > np.median(total) + 1.0
+
+
+def test_points_true_pose_scores_best_from_above():
+    """The upper-body model under a ceiling camera (the second paper's setting)."""
+    camera = camera_preset("kinect_v1", world_from_camera=look_at((0.0, 0.0, 3.2), (0.0, 0.0, 0.0)))
+    joints = pm.joints_from_pose(pm.pose_with(pm.standing_pose(), right_shoulder_flex=1.2, left_shoulder_abd=0.6))
+    obs = _frame(joints, scene.room(walls=()), camera=camera)
+    pose = pose_from_joints(UPPER, joints)
+    dofs = ("x", "y", "heading", "trunk_lean", "left_shoulder_flex", "left_shoulder_abd", "right_shoulder_flex",
+            "right_shoulder_abd", "right_elbow")
+    poses = _perturbed(UPPER, pose, dofs)
+    log_lik = make_likelihood("points", obs).evaluate(*_model_capsules(UPPER, poses))
+    assert log_lik.shape == (len(poses), 5)
+    assert np.argmax(log_lik.sum(axis=1)) == 0
+
+
+def test_free_space_penalises_an_arm_in_seen_empty_space(front):
+    obs, pose = front
+    out = pose.copy()
+    out[FULL.dof("left_shoulder_abd")] = 1.4  # the left arm raised sideways, the wall seen behind it
+    like = make_likelihood("points+free", obs)
+    log_lik = {name: term.evaluate(*_model_capsules(FULL, np.array([pose, out])))
+               for name, term in like.terms.items()}
+    arm = [FULL.part_names.index("left_upper_arm"), FULL.part_names.index("left_forearm")]
+    assert np.all(log_lik["free"][0] > -0.05)  # the true pose sits in occupied space
+    assert np.all(log_lik["free"][1, arm] < -0.5)  # most of the raised arm's samples see the wall behind
+    total = like.evaluate(*_model_capsules(FULL, np.array([pose, out]))).sum(axis=1)
+    assert total[0] > total[1] + 1.0
+
+
+def test_free_space_does_not_penalise_legs_behind_a_desk():
+    """Legs hidden by a desk's front panel (all but the tops of the thighs): the desk is in
+    front of the leg samples, at the true pose and with the legs spread behind it."""
+    joints = pm.joints_from_pose(pm.standing_pose(xy=(-0.1, 0.0)))
+    room = scene.room(walls=("-x",))
+    desk = scene.table((0.45, 0.0), size=(1.2, 0.5), panel=True)
+    obs = _frame(joints, concat([room, desk]))
+    pose = pose_from_joints(FULL, joints)
+    spread = pose.copy()
+    spread[[FULL.dof("left_hip_abd"), FULL.dof("right_hip_abd")]] += 0.3
+    spread[FULL.dof("left_knee")] += 0.4
+    capsules = _model_capsules(FULL, np.array([pose, spread]))
+    free = make_likelihood("free", obs).evaluate(*capsules)
+    legs = [FULL.part_names.index(n) for n in ("left_thigh", "left_shin", "right_thigh", "right_shin")]
+    shins = legs[1::2]
+    np.testing.assert_array_equal(free[0, legs], 0.0)
+    np.testing.assert_array_equal(free[1, shins], 0.0)
+    # without the desk the spread shins are seen to be wrong: the wall shows through them
+    open_free = make_likelihood("free", _frame(joints, room)).evaluate(*capsules)
+    assert np.all(open_free[0, legs] > -0.05) and np.all(open_free[1, shins] < -0.3)
+    # the render term, which has no notion of occlusion, does charge the hidden legs
+    render_legs = make_likelihood("render", obs).evaluate(*_model_capsules(FULL, pose))[0, legs]
+    assert render_legs.sum() < -0.5
+
+
+# --- API and input checks --------------------------------------------------------------------
+
+def test_registry_and_sums(front):
+    obs, pose = front
+    assert {"points", "free", "points+free", "render", "color", "points+color"} <= set(LIKELIHOODS)
+    with pytest.raises(ValueError, match="valid names"):
+        make_likelihood("nope", obs)
+    capsules = _model_capsules(FULL, _perturbed(FULL, pose, ("x",)))
+    both = make_likelihood("points+free", obs, points={"scale": 0.02}, free={"weight": 3.0})
+    want = (PointsLikelihood(obs, scale=0.02).evaluate(*capsules)
+            + FreeSpaceLikelihood(obs, weight=3.0).evaluate(*capsules))
+    np.testing.assert_allclose(both.evaluate(*capsules), want)
+    with pytest.raises(ValueError, match="as a dict under its name"):
+        make_likelihood("points+free", obs, scale=0.02)
+    with pytest.raises(ValueError, match="two or more"):
+        sum_of("points", "nope")
+    assert np.all(make_likelihood("color", obs).evaluate(*capsules) == 0.0)  # no reference yet
+
+
+def test_evaluate_checks_its_input(front):
+    obs, pose = front
+    like = PointsLikelihood(obs)
+    a, b, radii, part, k = _model_capsules(FULL, pose)
+    with pytest.raises(ValueError, match=r"\(P, C, 3\)"):
+        like.evaluate(a[0], b[0], radii, part, k)
+    with pytest.raises(ValueError, match="radii"):
+        like.evaluate(a, b, radii[:-1], part, k)
+    with pytest.raises(ValueError, match="capsule_part values"):
+        like.evaluate(a, b, radii, part, 3)
+    with pytest.raises(ValueError, match="num_parts"):
+        like.evaluate(a, b, radii, part, 0)
+    with pytest.raises(ValueError, match="finite"):
+        like.evaluate(a * np.nan, b, radii, part, k)
+    with pytest.raises(ValueError, match="scale"):
+        PointsLikelihood(obs, scale=0.0)
+    with pytest.raises(ValueError, match="at least one point"):
+        PointsLikelihood(Observation(np.zeros((0, 3)), obs.views))
+    with pytest.raises(ValueError, match="noise model"):
+        FreeSpaceLikelihood(obs, noise="sonar")
+
+
+def test_views_and_observations():
+    camera = Camera("c", 8, 6, 5.0, 5.0, 3.5, 2.5)
+    mask = np.zeros((6, 8), bool)
+    mask[2:4, 3:7] = True
+    assert roi_from_mask(mask, margin=0.0) == (2, 4, 3, 7)
+    assert roi_from_mask(mask, margin=0.5) == (1, 5, 1, 8)
+    assert roi_from_mask(np.zeros((6, 8), bool)) == (0, 0, 0, 0)
+    raw = np.full((6, 8), 2000, np.uint16)
+    raw[2, 3] = 0
+    view = View(camera, raw, mask)
+    assert view.depth.dtype == np.float32 and view.depth[0, 0] == pytest.approx(2.0)
+    assert view.roi == roi_from_mask(mask)
+    obs = observation_from_views([view, view])
+    assert obs.points.shape == (14, 3)  # 7 measured mask pixels per view
+    assert observation_from_views([view], max_points=3).points.shape == (3, 3)
+    with pytest.raises(ValueError, match="mask"):
+        View(camera, raw, mask[:, :4])
+    with pytest.raises(ValueError, match="depth"):
+        View(camera, np.zeros((6, 8), np.int32), mask)
+    with pytest.raises(ValueError, match="color"):
+        View(camera, raw, mask, color=np.zeros((6, 8, 3), np.float32))
+    with pytest.raises(ValueError, match="roi"):
+        View(camera, raw, mask, roi=(0, 7, 0, 8))
+    with pytest.raises(ValueError, match="max_points"):
+        observation_from_views([view], max_points=0)
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        Observation(np.zeros((4, 2)), ())
