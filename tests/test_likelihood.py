@@ -119,6 +119,24 @@ def test_point_distances_match_brute_force(rng):
     np.testing.assert_allclose(chosen, every.min(axis=2), atol=2e-6)
 
 
+def test_block_pruning_is_exact_on_a_body(front, rng):
+    """The blocked kernel (capsules skipped per block of nearby points) against one block
+    holding every point (every capsule visited), on a person's points and diffused poses."""
+    from occupose.likelihood import _kernels
+    from occupose.likelihood._capsules import blocked_points
+
+    obs, pose = front
+    poses = pose + rng.normal(size=(20, FULL.num_dofs)) * np.where(FULL.angular, 0.2, 0.05)
+    a, b, radii, _, _ = _model_capsules(FULL, poses)
+    distance, capsule = point_distances(a, b, radii, obs.points)
+    whole = blocked_points(obs.points, block_size=len(obs.points))
+    want_distance = np.empty((20, len(whole.px)), np.float32)
+    want_capsule = np.empty((20, len(whole.px)), np.int32)
+    _kernels.nearest_capsules(a, b, radii, *whole.kernel_args, want_distance, want_capsule)
+    np.testing.assert_allclose(distance, want_distance[:, whole.position], atol=1e-6)
+    assert np.mean(capsule == want_capsule[:, whole.position]) > 0.999
+
+
 def test_points_likelihood_matches_reference(rng):
     a, b, radii = _random_capsules(rng)
     part = np.array([0, 2, 1, 2, 0])
@@ -272,7 +290,7 @@ def _render_reference(a, b, radii, part, num_parts, view, stride, truncation):
 
 def test_render_matches_reference(rng):
     camera = Camera("c", 120, 100, 100.0, 100.0, 59.5, 49.5, world_from_camera=look_at((3, 0.3, 1.0), (0, 0, 1)))
-    a = rng.normal(size=(3, 4, 3)) * [0.15, 0.15, 0.3] + [0.0, 0.0, 1.0]
+    a = rng.normal(size=(8, 4, 3)) * [0.15, 0.15, 0.3] + [0.0, 0.0, 1.0]
     b = a + rng.normal(size=a.shape) * 0.2
     radii = rng.uniform(0.05, 0.12, (4, 2))
     b[0, 0] = a[0, 0]  # a sphere

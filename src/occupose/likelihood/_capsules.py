@@ -25,7 +25,8 @@ def check_capsules(a, b, radii, capsule_part, num_parts):
     num_capsules = a.shape[1]
     radii = np.ascontiguousarray(radii, dtype=np.float64)
     if radii.shape != (num_capsules, 2) or not np.all(np.isfinite(radii)) or np.any(radii <= 0):
-        raise ValueError(f"radii must be a ({num_capsules}, 2) array of positive finite metres, got shape {radii.shape}")
+        raise ValueError(f"radii must be a ({num_capsules}, 2) array of positive finite metres, "
+                         f"got shape {radii.shape}")
     part = np.asarray(capsule_part)
     if part.shape != (num_capsules,) or part.dtype.kind not in "iu":
         raise ValueError(f"capsule_part must be a ({num_capsules},) integer array, got {part.dtype} {part.shape}")
@@ -59,11 +60,11 @@ class PointBlocks(NamedTuple):
 
     origin : (3,) float64, metres, the points' centroid (0 for no points)
     px, py, pz : (M,) float32, the points minus origin, reordered into blocks and padded
-    weight : (M,) float32, 1 for a point, 0 for padding
     block_start : (B + 1,) int64; block b holds entries block_start[b] to block_start[b + 1] - 1
     block_centre : (3, B) float64 (minus origin) and block_radius : (B,) float64 metres,
         a ball holding each block (its radius plus a slack of ``BOUND_SLACK`` for float32
         rounding of the point distances)
+    weight : (M,) float32, 1 for a point, 0 for padding
     position : (N,) int64, where each input point went
     """
 
@@ -71,16 +72,16 @@ class PointBlocks(NamedTuple):
     px: np.ndarray
     py: np.ndarray
     pz: np.ndarray
-    weight: np.ndarray
     block_start: np.ndarray
     block_centre: np.ndarray
     block_radius: np.ndarray
+    weight: np.ndarray
     position: np.ndarray
 
     @property
     def kernel_args(self) -> tuple:
         """The arguments of the kernels, origin to block_radius."""
-        return tuple(self)[:8]
+        return tuple(self)[:7]
 
 
 def blocked_points(points: np.ndarray, block_size: int = BLOCK_SIZE, pad: int = BLOCK_PAD) -> PointBlocks:
@@ -117,5 +118,5 @@ def blocked_points(points: np.ndarray, block_size: int = BLOCK_SIZE, pad: int = 
         centre[b] = 0.5 * (block.min(axis=0) + block.max(axis=0))
         radius[b] = np.sqrt(np.max(np.sum((block - centre[b]) ** 2, axis=1)))
     px, py, pz = (np.ascontiguousarray(padded[:, i], dtype=np.float32) for i in range(3))
-    return PointBlocks(origin, px, py, pz, weight, start, np.ascontiguousarray(centre.T), radius + BOUND_SLACK,
+    return PointBlocks(origin, px, py, pz, start, np.ascontiguousarray(centre.T), radius + BOUND_SLACK, weight,
                        position)

@@ -1,9 +1,9 @@
 """Numba kernels of the likelihoods (private: use the classes of :mod:`occupose.likelihood`).
 
 Every kernel takes the particles' capsules as ``a, b`` (P, C, 3) float64 world metres (the
-two ends of each round cone) with ``radii`` (C, 2) float64 (radius at a, at b) and
-``capsule_part`` (C,) int64, runs in parallel over particles, and adds its result into
-``out`` (P, K) float64, one column per part.
+two ends of each round cone) with ``radii`` (C, 2) float64 (radius at a, at b) and, where
+parts matter, ``capsule_part`` (C,) int64; runs in parallel over particles; and adds its
+result into an output array, (P, K) float64 (one column per part) for the likelihoods.
 
 Loop order for speed (measured): particles outer (one per thread), then blocks of nearby
 points, capsules next (nearest first, skipping those that cannot be the nearest of any
@@ -148,14 +148,13 @@ def _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_cen
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def nearest_capsules(a, b, radii, origin, px, py, pz, weight, block_start, block_centre, block_radius, distance,
-                     capsule):
+def nearest_capsules(a, b, radii, origin, px, py, pz, block_start, block_centre, block_radius, distance, capsule):
     """Each point's distance to the nearest capsule surface and that capsule, per particle.
 
     origin : (3,) float64; px, py, pz : (M,) float32, points minus origin, in blocks
     (block_start (B + 1,) int64, block_centre (3, B) float64 minus origin, block_radius
-    (B,) float64; see :func:`_nearest_capsules`); weight : (M,) float32, unused here;
-    distance : (P, M) float32 out, metres; capsule : (P, M) int32 out.
+    (B,) float64; see :func:`_nearest_capsules`); distance : (P, M) float32 out, metres;
+    capsule : (P, M) int32 out.
     """
     for p in numba.prange(a.shape[0]):
         _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius,
@@ -173,10 +172,11 @@ def _capsule_sum(best, weight, arg, c):
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def point_distance_sums(a, b, radii, capsule_part, origin, px, py, pz, weight, block_start, block_centre,
-                        block_radius, out):
+def point_distance_sums(a, b, radii, capsule_part, origin, px, py, pz, block_start, block_centre, block_radius,
+                        weight, out):
     """out[p, k] += sum of weight * distance over the points whose nearest capsule belongs to
-    part k. Arguments as :func:`nearest_capsules`; out : (P, K) float64.
+    part k. Arguments as :func:`nearest_capsules`; weight : (M,) float32 (0 for padding);
+    out : (P, K) float64.
     """
     n = px.shape[0]
     for p in numba.prange(a.shape[0]):
@@ -313,15 +313,72 @@ def color_counts(a, b, radii, capsule_part, rotation, shift, eye, fx, fy, cx, cy
                         counts[p, k, cells[v, u]] += 1.0
 
 
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+def _hull_row_span(rect, y):
+    """x range (lo, hi) at height y of the convex hull of two axis-aligned rectangles
+    rect[e] = (x0, x1, y0, y1), e = 0, 1; lo > hi when the row misses the hull.
+
+    The hull is {(1 - t) p + t q : p in rect 0, q in rect 1, t in [0, 1]}: at height y, t
+    must keep y between the lerped bottoms and tops, an interval of t, and x spans the
+    lerped left and right sides over that interval (extremes at its ends).
+    """
+    t_lo, t_hi = 0.0, 1.0
+    for side in range(2):  # bottom: y0(t) <= y; top: y1(t) >= y
+        start, slope = rect[0, 2 + side], rect[1, 2 + side] - rect[0, 2 + side]
+        gap = y - start  # bottom: slope t <= gap; top: slope t >= gap
+        if side == 1:
+            slope, gap = -slope, -gap
+        if slope > 0.0:
+            t_hi = min(t_hi, gap / slope)
+        elif slope < 0.0:
+            t_lo = max(t_lo, gap / slope)
+        elif gap < 0.0:
+            return np.inf, -np.inf
+    if t_lo > t_hi:
+        return np.inf, -np.inf
+    left_lo = rect[0, 0] + t_lo * (rect[1, 0] - rect[0, 0])
+    left_hi = rect[0, 0] + t_hi * (rect[1, 0] - rect[0, 0])
+    right_lo = rect[0, 1] + t_lo * (rect[1, 1] - rect[0, 1])
+    right_hi = rect[0, 1] + t_hi * (rect[1, 1] - rect[0, 1])
+    return min(left_lo, left_hi), max(right_lo, right_hi)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _nearest_of_few(consts, n, qx, qy, qz, best, arg):
+    """``arg[i]`` = the capsule nearest (|signed distance|) point i of the first n points
+    qx, qy, qz (float32) among the capsules of ``consts`` (C, 12) (constants of
+    :func:`_capsule_constants` in the points' frame); exhaustive, vectorised over points."""
+    f = np.float32
+    for i in range(n):
+        best[i] = np.inf
+        arg[i] = 0
+    for c in range(consts.shape[0]):
+        ax, ay, az = f(consts[c, 0]), f(consts[c, 1]), f(consts[c, 2])
+        ex, ey, ez = f(consts[c, 3]), f(consts[c, 4]), f(consts[c, 5])
+        length, k, s, g = f(consts[c, 6]), f(consts[c, 7]), f(consts[c, 8]), f(consts[c, 9])
+        r1, r2 = f(consts[c, 10]), f(consts[c, 11])
+        cc = np.int32(c)
+        for i in range(n):
+            d = abs(_round_cone_distance(qx[i], qy[i], qz[i], ax, ay, az, ex, ey, ez, length, k, s, g, r1, r2))
+            current = best[i]
+            arg[i] = cc if d < current else arg[i]
+            best[i] = min(d, current)
+
+
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
 def render_sigmas(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, u0, v0, stride, observed,
-                  truncation, out):
+                  observed_index, observed_x, observed_y, observed_z, truncation, num_chunks, out):
     """out[p, k] += the first paper's sigma over a pixel grid of one view, split by part.
 
     rotation (3, 3), shift (3,) : camera_from_world; fx, fy, cx, cy : intrinsics (pixels);
     the grid's pixel (gv, gu) is image pixel (v0 + stride gv, u0 + stride gu);
     observed : (Gv, Gu) float64, metres, the observed depth where the pixel is in the
-    person's silhouette, else 0; truncation : D, metres.
+    person's silhouette, else 0; observed_index : (M,) int64, the flat grid index
+    gv * Gu + gu of each such pixel; observed_x, _y, _z : (M,) float32, metres, their
+    back-projected points in the camera frame; truncation : D, metres; num_chunks : the
+    particles are run in that many chunks in parallel (a few per thread), so that the grid
+    buffers are allocated and cleared once per chunk (then reset only where the model
+    touched them).
 
     Each particle's capsules are ray-cast (exact hits, nearest camera z) into the grid
     pixels of their screen rectangles. A pixel in both silhouettes adds
@@ -331,79 +388,114 @@ def render_sigmas(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, u0
     """
     num_v, num_u = observed.shape
     num_capsules = a.shape[1]
-    for p in numba.prange(a.shape[0]):
+    num_observed = observed_index.shape[0]
+    flat_observed = observed.reshape(-1)
+    num_particles = a.shape[0]
+    for chunk in numba.prange(num_chunks):
         kinds = np.empty(num_capsules, np.int8)
         params = np.zeros((num_capsules, 16))
         consts = np.empty((num_capsules, 12))
-        zbuf = np.full((num_v, num_u), np.inf)
-        winner = np.full((num_v, num_u), -1, np.int64)
-        for c in range(num_capsules):
-            # Capsule ends in the camera frame.
-            for end in range(2):
-                x = a[p, c, 0] if end == 0 else b[p, c, 0]
-                y = a[p, c, 1] if end == 0 else b[p, c, 1]
-                z = a[p, c, 2] if end == 0 else b[p, c, 2]
-                for i in range(3):
-                    params[c, 3 * end + i] = rotation[i, 0] * x + rotation[i, 1] * y + rotation[i, 2] * z + shift[i]
-            params[c, 6], params[c, 7] = radii[c, 0], radii[c, 1]
-            values = _capsule_constants(params[c, 0], params[c, 1], params[c, 2], params[c, 3], params[c, 4],
-                                        params[c, 5], params[c, 6], params[c, 7])
-            for i in range(12):
-                consts[c, i] = values[i]
-            # Screen rectangle from the two end spheres' bounding boxes.
-            lo_x, hi_x, lo_y, hi_y = np.inf, -np.inf, np.inf, -np.inf
-            behind = False
-            for end in range(2):
-                x, y, z = params[c, 3 * end], params[c, 3 * end + 1], params[c, 3 * end + 2]
-                r = radii[c, end]
-                if z - r <= 1e-6:
-                    behind = True
-                    break
-                for zz in (z - r, z + r):
-                    lo_x = min(lo_x, (x - r) / zz)
-                    hi_x = max(hi_x, (x + r) / zz)
-                    lo_y = min(lo_y, (y - r) / zz)
-                    hi_y = max(hi_y, (y + r) / zz)
+        zbuf = np.full(num_v * num_u, np.inf, np.float32)
+        winner = np.full(num_v * num_u, -1, np.int32)
+        touched = np.empty(num_v * num_u, np.int32)  # the grid pixels the model covers
+        missed_x = np.empty(num_observed, np.float32)
+        missed_y = np.empty(num_observed, np.float32)
+        missed_z = np.empty(num_observed, np.float32)
+        best = np.empty(num_observed, np.float32)
+        arg = np.empty(num_observed, np.int32)
+        for p in range(chunk * num_particles // num_chunks, (chunk + 1) * num_particles // num_chunks):
+            _render_particle(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, u0, v0, stride,
+                             flat_observed, num_v, num_u, observed_index, observed_x, observed_y, observed_z,
+                             truncation, p, kinds, params, consts, zbuf, winner, touched, missed_x, missed_y,
+                             missed_z, best, arg, out)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _render_particle(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, u0, v0, stride, flat_observed,
+                     num_v, num_u, observed_index, observed_x, observed_y, observed_z, truncation, p, kinds, params,
+                     consts, zbuf, winner, touched, missed_x, missed_y, missed_z, best, arg, out):
+    """One particle of :func:`render_sigmas`; the buffers come in cleared (zbuf inf, winner
+    -1) and are left so."""
+    num_capsules = a.shape[1]
+    num_touched = 0
+    rect = np.empty((2, 4))  # per end sphere: x0, x1, y0, y1 of its image
+    for c in range(num_capsules):
+        # Capsule ends in the camera frame.
+        for end in range(2):
+            x = a[p, c, 0] if end == 0 else b[p, c, 0]
+            y = a[p, c, 1] if end == 0 else b[p, c, 1]
+            z = a[p, c, 2] if end == 0 else b[p, c, 2]
+            for i in range(3):
+                params[c, 3 * end + i] = rotation[i, 0] * x + rotation[i, 1] * y + rotation[i, 2] * z + shift[i]
+        params[c, 6], params[c, 7] = radii[c, 0], radii[c, 1]
+        values = _capsule_constants(params[c, 0], params[c, 1], params[c, 2], params[c, 3], params[c, 4],
+                                    params[c, 5], params[c, 6], params[c, 7])
+        for i in range(12):
+            consts[c, i] = values[i]
+        # Each end sphere's image lies in the rectangle that bounds its bounding box's image
+        # (in x/z, y/z); the round cone, the convex hull of the two spheres, images into the
+        # convex hull of the two rectangles, scanned row by row below.
+        behind = False
+        for end in range(2):
+            x, y, z = params[c, 3 * end], params[c, 3 * end + 1], params[c, 3 * end + 2]
+            r = radii[c, end]
+            if z - r <= 1e-6:
+                behind = True
+                break
+            rect[end, 0] = min((x - r) / (z - r), (x - r) / (z + r))
+            rect[end, 1] = max((x + r) / (z - r), (x + r) / (z + r))
+            rect[end, 2] = min((y - r) / (z - r), (y - r) / (z + r))
+            rect[end, 3] = max((y + r) / (z - r), (y + r) / (z + r))
+        if behind:
+            gv0, gv1 = 0, num_v - 1
+        else:
+            gv0 = max(int(math.ceil((fy * min(rect[0, 2], rect[1, 2]) + cy - v0) / stride)), 0)
+            gv1 = min(int(math.floor((fy * max(rect[0, 3], rect[1, 3]) + cy - v0) / stride)), num_v - 1)
+        kinds[c] = ROUND_CONE
+        if consts[c, 6] == 0.0:  # degenerate: the larger sphere, cast as a unit-sphere ellipsoid
+            kinds[c] = ELLIPSOID
+            r = consts[c, 10]
+            params[c, 0:3] = -consts[c, 0:3] / r
+            params[c, 3:12] = 0.0
+            params[c, 3] = params[c, 7] = params[c, 11] = 1.0 / r
+        for gv in range(gv0, gv1 + 1):
+            ray_y = (v0 + stride * gv - cy) / fy
             if behind:
-                gu0, gu1, gv0, gv1 = 0, num_u - 1, 0, num_v - 1
+                gu0, gu1 = 0, num_u - 1
             else:
+                lo_x, hi_x = _hull_row_span(rect, ray_y)
+                if lo_x > hi_x:
+                    continue
                 gu0 = max(int(math.ceil((fx * lo_x + cx - u0) / stride)), 0)
                 gu1 = min(int(math.floor((fx * hi_x + cx - u0) / stride)), num_u - 1)
-                gv0 = max(int(math.ceil((fy * lo_y + cy - v0) / stride)), 0)
-                gv1 = min(int(math.floor((fy * hi_y + cy - v0) / stride)), num_v - 1)
-            kinds[c] = ROUND_CONE
-            if consts[c, 6] == 0.0:  # degenerate: the larger sphere, cast as a unit-sphere ellipsoid
-                kinds[c] = ELLIPSOID
-                r = consts[c, 10]
-                params[c, 0:3] = -consts[c, 0:3] / r
-                params[c, 3:12] = 0.0
-                params[c, 3] = params[c, 7] = params[c, 11] = 1.0 / r
-            for gv in range(gv0, gv1 + 1):
-                ray_y = (v0 + stride * gv - cy) / fy
-                for gu in range(gu0, gu1 + 1):
-                    depth = _depth(kinds[c], params, c, (u0 + stride * gu - cx) / fx, ray_y)
-                    if 0.0 < depth < zbuf[gv, gu]:
-                        zbuf[gv, gu] = depth
-                        winner[gv, gu] = c
-        for gv in range(num_v):
-            ray_y = (v0 + stride * gv - cy) / fy
-            for gu in range(num_u):
-                d_obs = observed[gv, gu]
-                c = winner[gv, gu]
-                if c >= 0:
-                    if d_obs > 0.0:
-                        f = min(abs(d_obs - zbuf[gv, gu]) / truncation, 1.0)
-                        out[p, capsule_part[c]] += f * f
-                    else:
-                        out[p, capsule_part[c]] += 1.0
-                elif d_obs > 0.0:
-                    qx, qy, qz = (u0 + stride * gu - cx) / fx * d_obs, ray_y * d_obs, d_obs
-                    nearest, best = 0, np.inf
-                    for k in range(num_capsules):
-                        d = abs(_round_cone_distance(qx, qy, qz, consts[k, 0], consts[k, 1], consts[k, 2],
-                                                     consts[k, 3], consts[k, 4], consts[k, 5], consts[k, 6],
-                                                     consts[k, 7], consts[k, 8], consts[k, 9], consts[k, 10],
-                                                     consts[k, 11]))
-                        if d < best:
-                            nearest, best = k, d
-                    out[p, capsule_part[nearest]] += 1.0
+            for gu in range(gu0, gu1 + 1):
+                depth = np.float32(_depth(kinds[c], params, c, (u0 + stride * gu - cx) / fx, ray_y))
+                g = gv * num_u + gu
+                if 0.0 < depth < zbuf[g]:
+                    if winner[g] < 0:
+                        touched[num_touched] = g
+                        num_touched += 1
+                    zbuf[g] = depth
+                    winner[g] = c
+    for t in range(num_touched):  # model-only pixels
+        g = touched[t]
+        if flat_observed[g] == 0.0:
+            out[p, capsule_part[winner[g]]] += 1.0
+    num_missed = 0
+    for m in range(observed_index.shape[0]):  # pixels in both silhouettes, and observation-only ones
+        g = observed_index[m]
+        c = winner[g]
+        if c >= 0:
+            f = min(abs(flat_observed[g] - zbuf[g]) / truncation, 1.0)
+            out[p, capsule_part[c]] += f * f
+        else:
+            missed_x[num_missed] = observed_x[m]
+            missed_y[num_missed] = observed_y[m]
+            missed_z[num_missed] = observed_z[m]
+            num_missed += 1
+    _nearest_of_few(consts, num_missed, missed_x, missed_y, missed_z, best, arg)
+    for i in range(num_missed):
+        out[p, capsule_part[arg[i]]] += 1.0
+    for t in range(num_touched):
+        zbuf[touched[t]] = np.inf
+        winner[touched[t]] = -1

@@ -17,12 +17,14 @@ from occupose.likelihood import _kernels
 from occupose.likelihood._capsules import blocked_points, check_capsules, check_positive
 from occupose.likelihood.observation import Observation
 
-#: Default distance scale, metres: every centimetre of mean point-to-model distance costs
-#: one nat (the paper's exp(-d) with d in centimetres). Measured on a synthetic frame (a
-#: capsule model on a differently shaped rendered body, 2000 points, 200 particles): the
-#: mean distance is 1.8 cm at the true pose and 2.6-9 cm for particles diffused by 0.1 rad
-#: and 3 cm per DOF, which leaves an effective sample size of 121 of 200 (0.05 m: 190,
-#: nearly flat; 0.005 m: 62). Annealed filters rescale it anyway.
+#: Default distance scale, metres: each centimetre of mean point-to-model distance costs
+#: one nat (the paper's exp(-d) with d in centimetres). Every term's default is set so
+#: that, alone, it keeps about half of the particles effective in one calibration: the
+#: ``full`` model at the fitted true pose of a synthetic frame (a person facing a Kinect
+#: 3 m away, as in tests/test_likelihood.py) and 200 particles diffused by 0.1 rad / 3 cm
+#: per DOF. There the mean distance is 1.7 cm at the true pose and the effective sample
+#: size 103 of 200 (scale 0.05 m: 189, nearly flat; 0.005 m: 46). Annealed filters
+#: rescale it anyway.
 POINTS_SCALE = 0.01
 
 
@@ -67,6 +69,6 @@ class PointsLikelihood:
         radii (C, 2) metres, capsule_part (C,) int in [0, num_parts)."""
         a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
         out = np.zeros((a.shape[0], num_parts))
-        _kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, out)
+        _kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, self._blocks.weight, out)
         out *= -1.0 / (self.num_points * self.scale)
         return out

@@ -22,16 +22,18 @@ point, so that a part which drifted away from its pixels pays for them.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from occupose.likelihood import _kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
+from occupose.likelihood._samples import camera_arrays
 from occupose.likelihood.observation import Observation
 
 #: Default scale, nats per observed-silhouette share of sigma: a model that misses a tenth
 #: of the silhouette (about one limb) and covers as much elsewhere costs 5 x 0.2 = 1 nat.
-#: Chosen for the same selectivity as the points term's default: on the same synthetic
-#: frame and diffusion the effective sample size is 132 of 200 (points: 121).
+#: Calibrated as the points scale (occupose.likelihood.points.POINTS_SCALE): an effective
+#: sample size of 121 of 200 (scale 10: 39).
 RENDER_SCALE = 5.0
 #: The paper's truncation D, metres.
 RENDER_TRUNCATION = 0.1
@@ -63,20 +65,25 @@ class RenderLikelihood:
             v0, v1, u0, u1 = view.roi
             if v1 <= v0 or u1 <= u0:
                 continue
-            rows, cols = slice(v0, v1, self.stride), slice(u0, u1, self.stride)
-            observed = np.where(view.mask[rows, cols], view.depth[rows, cols], 0.0).astype(np.float64)
-            self.num_observed += int(np.count_nonzero(observed))
-            pose = view.camera.camera_from_world
-            self._views.append((np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3]),
-                                view.camera, u0, v0, np.ascontiguousarray(observed)))
+            rows, cols = np.arange(v0, v1, self.stride), np.arange(u0, u1, self.stride)
+            observed = np.where(view.mask[np.ix_(rows, cols)], view.depth[np.ix_(rows, cols)], 0.0).astype(np.float64)
+            index = np.flatnonzero(observed)
+            gv, gu = np.divmod(index, len(cols))
+            cam = view.camera
+            z = observed.reshape(-1)[index]
+            back = [(cols[gu] - cam.cx) / cam.fx * z, (rows[gv] - cam.cy) / cam.fy * z, z]
+            self.num_observed += len(index)
+            self._views.append((*camera_arrays(cam)[:2], cam, u0, v0, np.ascontiguousarray(observed), index,
+                                *(np.ascontiguousarray(c, dtype=np.float32) for c in back)))
 
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """(P, K) float64 log-likelihoods of particles with capsules a, b (P, C, 3) metres,
         radii (C, 2) metres, capsule_part (C,) int in [0, num_parts)."""
         a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
         out = np.zeros((a.shape[0], num_parts))
-        for rotation, shift, cam, u0, v0, observed in self._views:
+        for rotation, shift, cam, u0, v0, observed, index, x, y, z in self._views:
             _kernels.render_sigmas(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
-                                   u0, v0, self.stride, observed, self.truncation, out)
+                                   u0, v0, self.stride, observed, index, x, y, z, self.truncation,
+                                   min(a.shape[0], 4 * numba.get_num_threads()), out)
         out *= -self.scale / max(self.num_observed, 1)
         return out
