@@ -27,7 +27,7 @@ from occupose.likelihood.observation import Observation
 #: Default scale, nats for a part whose colours share nothing with its reference (d = 1).
 #: Calibrated as the points scale (occupose.likelihood.points.POINTS_SCALE), with the
 #: reference taken from a slightly different pose of the frame before: an effective sample
-#: size of 89 of 200 (scale 2: 16, the term then overrides the depth evidence).
+#: size of 88 of 200 (scale 2: 38).
 COLOR_SCALE = 1.0
 #: Default histogram cells per RGB channel (4 -> 64 cells; 8 -> 512 is too sparse for the
 #: few dozen samples of a limb).

@@ -28,9 +28,9 @@ from occupose.likelihood._samples import camera_arrays, depth_tolerance, sample_
 from occupose.likelihood.observation import Observation
 
 #: Default weight, nats for a part wholly in seen-empty space. Calibrated as the points
-#: scale (occupose.likelihood.points.POINTS_SCALE): the term is 0 at the true pose and
-#: leaves an effective sample size of 83 of 200 alone, 24 together with ``points``
-#: (weight 0.5: 143 and 52).
+#: scale (occupose.likelihood.points.POINTS_SCALE): the term is -0.03 at the true pose and
+#: leaves an effective sample size of 86 of 200 alone, 42 together with ``points``
+#: (weight 0.5: 144 and 71).
 FREE_WEIGHT = 1.0
 #: Default margin beyond 3 sigma of sensor noise, metres: the capsule model's radius error
 #: (a few cm) plus the surface samples' offset from the true surface.

@@ -33,7 +33,7 @@ from occupose.likelihood.observation import Observation
 #: Default scale, nats per observed-silhouette share of sigma: a model that misses a tenth
 #: of the silhouette (about one limb) and covers as much elsewhere costs 5 x 0.2 = 1 nat.
 #: Calibrated as the points scale (occupose.likelihood.points.POINTS_SCALE): an effective
-#: sample size of 121 of 200 (scale 10: 39).
+#: sample size of 123 of 200 (scale 10: 40).
 RENDER_SCALE = 5.0
 #: The paper's truncation D, metres.
 RENDER_TRUNCATION = 0.1
