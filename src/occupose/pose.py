@@ -1,0 +1,112 @@
+"""Stage 3 for one person: a body model, a likelihood and a particle filter, joined.
+
+:class:`PoseProblem` is the filter's view of one person (see
+:class:`occupose.filters.base.Problem`): the model's state space and the log-likelihood of
+poses under the current observation. :class:`PoseEstimator` holds a person's filter across
+frames; the tracker keeps one per track.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
+from occupose.filters import make_filter
+from occupose.likelihood import Observation, make_likelihood
+
+
+class PoseProblem:
+    """One person's pose as a particle-filter problem.
+
+    model : the body model; likelihood : a name of occupose.likelihood.LIKELIHOODS
+    diffusion : (D,) random-walk std per frame (default: the model's defaults at ``fps``)
+    likelihood_options : passed to the likelihood class every frame
+    stages : the partitioned-sampling order as groups of the model's partitions (indices
+        into ``model.partitions``), each group sampled as one partition; default: the root,
+        then head and arms, then legs (the model's own partitions when it has no legs)
+    """
+
+    def __init__(self, model: BodyModel, likelihood: str = "points+free", *, fps: float = 30.0,
+                 diffusion: np.ndarray | None = None, likelihood_options: dict | None = None,
+                 stages: list[list[int]] | None = None):
+        self.model = model
+        self.likelihood_name = likelihood
+        self.likelihood_options = dict(likelihood_options or {})
+        self.num_dofs = model.num_dofs
+        self.limits = model.limits
+        self.angular = model.angular
+        self.diffusion = diffusion_scales(model, fps) if diffusion is None else np.asarray(diffusion, float)
+        # Each partition is weighted by the whole model's likelihood: the other partitions'
+        # DOFs are fixed while it is sampled, so this is its conditional likelihood. With
+        # points assigned to their nearest part, a part's own column alone rewards a limb
+        # moved into empty space (no points left to explain), which makes limbs drift.
+        everything = np.arange(len(model.part_names))
+        stages = default_stages(model) if stages is None else stages
+        self.partitions = [type(model.partitions[0])(np.concatenate([model.partitions[i].dofs for i in group]),
+                                                     everything) for group in stages]
+        self.weight_groups = model.weight_groups
+        self.hidden_parts = np.zeros(len(model.part_names), bool)
+        self._likelihood = None
+
+    def set_observation(self, observation: Observation) -> None:
+        """Use this frame's observation for the following likelihood calls."""
+        self._likelihood = make_likelihood(self.likelihood_name, observation, **self.likelihood_options)
+
+    def log_likelihood(self, poses: np.ndarray) -> np.ndarray:
+        """(P, K) per-part log-likelihoods of poses (P, D); hidden parts give 0."""
+        if self._likelihood is None:
+            raise ValueError("set_observation() must be called before evaluating poses")
+        a, b = capsules_from_poses(self.model, poses)
+        out = self._likelihood.evaluate(a, b, self.model.capsule_radii, self.model.capsule_part,
+                                        len(self.model.part_names))
+        out[:, self.hidden_parts] = 0.0
+        return out
+
+
+def default_stages(model: BodyModel) -> list[list[int]]:
+    """Partitioned-sampling stages: the root partition, then the head and arms together,
+    then the legs together (a model without legs: root, then everything else)."""
+    legs = [i for i, p in enumerate(model.partitions)
+            if any("thigh" in model.part_names[k] or "shin" in model.part_names[k] for k in p.parts) and i > 0]
+    rest = [i for i in range(1, len(model.partitions)) if i not in legs]
+    return [group for group in ([0], rest, legs) if group]
+
+
+class PoseEstimator:
+    """A particle filter on one person's pose, stepped frame by frame.
+
+    filter : a name of occupose.filters.FILTERS; particles : number of particles;
+    rng : np.random.Generator; velocity_damping : share of the root's last translation
+    added to every particle before a step (constant-velocity prediction; 0 = none);
+    filter_options : e.g. ``num_layers``
+    """
+
+    def __init__(self, problem: PoseProblem, filter: str, particles: int, rng: np.random.Generator,
+                 velocity_damping: float = 0.8, **filter_options):
+        self.problem = problem
+        self.filter = make_filter(filter, problem, particles, rng, **filter_options)
+        self.velocity_damping = velocity_damping
+        self._previous = None
+
+    def initialise(self, pose: np.ndarray, spread: float | np.ndarray = 0.0) -> None:
+        """Start from ``pose`` (D,), particles spread by ``spread`` std (scalar or (D,))."""
+        self.filter.initialise(np.asarray(pose, float), spread)
+        self._previous = np.asarray(pose, float).copy()
+
+    def step(self, observation: Observation, *, active: np.ndarray | None = None,
+             diffusion_scale: np.ndarray | None = None) -> np.ndarray:
+        """Estimate this frame's pose (D,) from ``observation``; ``active`` (D,) bool freezes
+        the other DOFs, ``diffusion_scale`` (D,) widens the search per DOF."""
+        self.problem.set_observation(observation)
+        current = self.filter.estimate
+        if self.velocity_damping > 0 and current is not None:
+            drift = root_drift(self.problem.model, self._previous, current, self.velocity_damping)
+            if active is not None:
+                drift[~active] = 0.0
+            self.filter.particles = self.filter.particles + drift
+            self._previous = current.copy()
+        return self.filter.step(active=active, diffusion_scale=diffusion_scale)
+
+    def joints(self, pose: np.ndarray) -> np.ndarray:
+        """(15, 3) canonical joints of ``pose`` (NaN for joints the model does not report)."""
+        return joints_from_poses(self.problem.model, np.asarray(pose, float)[None])[0]
