@@ -329,9 +329,15 @@ def test_model_fitted_to_ground_truth_explains_the_rendered_person():
 
 
 def _first_points(seed: int):
+    """Points of the first two frames where the no_occlusion person stands upright (still,
+    hands below the shoulders): dims_from_observation assumes a standing person."""
     scenario = build_scenario("no_occlusion", seed=seed, use_mocap=False)
+    joints = scenario.people[0].joints
+    speed = np.linalg.norm(np.diff(joints[:, 2, :2], axis=0), axis=1) * scenario.fps
+    hands_low = np.all(joints[1:, [5, 8], 2] < joints[1:, [3, 6], 2], axis=1)
+    first = 1 + int(np.flatnonzero((speed < 0.05) & hands_low)[0])
     points = []
-    for frame in frames(scenario, seed=0, num_frames=2):
+    for frame in frames(scenario, seed=0, indices=[first, first + 1]):
         for cam in scenario.cameras:
             depth = np.where(frame.rendered[cam.name].person == 1, frame.depth[cam.name], 0.0).astype(np.float32)
             points.append(points_from_depth(depth, cam)[0])
