@@ -34,7 +34,7 @@ def test_synth_refuses_bad_input(tmp_path, recording):
     result = runner.invoke(main, ["synth", "no_occlusion", str(recording), "--frames", "2"])
     assert result.exit_code != 0 and "exists and is not empty (use --force" in result.output
     result = runner.invoke(main, ["synth", "no_occlusion", str(tmp_path / "y"), "--frames", "9999"])
-    assert result.exit_code != 0 and "--frames must be in 1..360" in result.output
+    assert result.exit_code != 0 and "--frames must be in 1..390" in result.output
     result = runner.invoke(main, ["synth", "no_occlusion", str(tmp_path / "z"), "--sensor", "webcam"])
     assert result.exit_code != 0 and "unknown camera preset 'webcam'" in result.output
 
