@@ -96,6 +96,15 @@ def test_pieces_in_one_column_make_one_blob():
     assert len(apart) == 4
 
 
+@pytest.mark.parametrize("gap, joined", [(1, True), (2, True), (3, False)])
+def test_footprints_join_across_a_gap_of_join_m(gap, joined):
+    mask = np.zeros(SPEC.shape, bool)
+    mask[10:16, 10:12, 20:34] = True  # upper body
+    mask[16 + gap:20 + gap, 10 + gap:12 + gap, 0:10] = True  # diagonal from it, gap empty cells apart
+    _, blobs = blobs_from_mask(mask, SPEC, join_m=0.1, min_cells=1, min_height=0, min_top=0)
+    assert len(blobs) == (1 if joined else 2)
+
+
 def test_union_of_blobs_pools_cells():
     a, b = people((-1.0, 0.0), (1.0, 0.0))
     both = union_of_blobs([b, a])

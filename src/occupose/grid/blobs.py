@@ -2,8 +2,9 @@
 
 The first paper labels moving cells with an iterative smallest-neighbour scheme (section
 III-B); here a union-find over the moving cells only (:mod:`occupose.grid._label_kernels`)
-gives the same components as ``scipy.ndimage.label`` with a full 3x3x3 structure, about
-ten times faster on a sparse 80 x 80 x 50 grid (~0.3 ms against ~2.7 ms). Components in
+gives the same components as ``scipy.ndimage.label`` with a full 3x3x3 structure, much
+faster on a sparse grid (80 x 80 x 50 cells, 664 of them moving, two people: 0.11 ms
+against 2.8 ms; scipy visits every cell). Components in
 one vertical column are joined (a body seen in pieces), and blobs too small or too flat to
 be a person are dropped.
 """
@@ -92,9 +93,13 @@ def _groups(moving: np.ndarray, labels: np.ndarray, flat: np.ndarray, num: int, 
     footprint = np.zeros(nx * ny, bool)
     footprint[flat // nz] = True
     footprint = footprint.reshape(nx, ny)
-    reach = int(np.floor(join_cells / 2 + 1e-9))
-    if reach > 0:
-        footprint = ndimage.binary_dilation(footprint, np.ones((3, 3), bool), iterations=reach)
+    for _ in range(int(np.floor(join_cells / 2 + 1e-9))):  # grow by one cell (chessboard)
+        grown = footprint.copy()
+        grown[1:] |= footprint[:-1]
+        grown[:-1] |= footprint[1:]
+        footprint = grown.copy()
+        footprint[:, 1:] |= grown[:, :-1]
+        footprint[:, :-1] |= grown[:, 1:]
     columns, _ = ndimage.label(footprint, np.ones((3, 3), bool))
     first = np.zeros(num, np.int64)
     first[labels[flat] - 1] = flat  # any cell of each component

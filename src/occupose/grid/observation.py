@@ -286,8 +286,10 @@ def persons_from_tracks(assigned: Sequence[np.ndarray], truth: Sequence[np.ndarr
     assigned, truth = list(assigned), list(truth)
     if len(assigned) != len(truth) or any(np.shape(a) != np.shape(t) for a, t in zip(assigned, truth)):
         raise ValueError("assigned and truth must be sequences of label images of matching shapes")
-    tracks = np.concatenate([np.asarray(a).reshape(-1) for a in assigned]).astype(np.int64) if assigned else np.zeros(0, np.int64)
-    people = np.concatenate([np.asarray(t).reshape(-1) for t in truth]).astype(np.int64) if truth else np.zeros(0, np.int64)
+    if not assigned:
+        return {}
+    tracks = np.concatenate([np.asarray(a).reshape(-1) for a in assigned]).astype(np.int64)
+    people = np.concatenate([np.asarray(t).reshape(-1) for t in truth]).astype(np.int64)
     both = (tracks > 0) & (people > 0)
     tracks, people = tracks[both], people[both]
     if tracks.size == 0:

@@ -97,6 +97,7 @@ class _Track:
     blob: Blob | None = None
     cells: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    box: tuple[np.ndarray, np.ndarray] = (np.zeros(3), np.zeros(3))  # low, high of ``points``
 
 
 def _number(value, what: str, low: float, high: float = np.inf, *, open_low: bool = False) -> float:
@@ -115,8 +116,9 @@ def _overlap(a: np.ndarray, b: np.ndarray) -> int:
     return int(np.count_nonzero(a[at] == b))
 
 
-def _boxes_touch(blob: Blob, points: np.ndarray, margin: float) -> bool:
-    return bool(np.all(points.min(axis=0) <= blob.high + margin) and np.all(blob.low - margin <= points.max(axis=0)))
+def _boxes_touch(blob: Blob, low: np.ndarray, high: np.ndarray) -> bool:
+    """Whether the blob's box and the box from ``low`` to ``high`` (3,) overlap."""
+    return bool(np.all(low <= blob.high) and np.all(blob.low <= high))
 
 
 class BlobTracker:
@@ -211,6 +213,7 @@ class BlobTracker:
             points = np.concatenate([blobs[c].centers[i] for c, i in zip(mine, owned[tr.track_id])])
             order = np.argsort(cells, kind="stable")
             tr.cells, tr.points = cells[order], points[order]
+            tr.box = (tr.points.min(axis=0), tr.points.max(axis=0))
             self._measure(tr, tr.points.mean(axis=0))
         for c, claimers in claims.items():
             for tr in claimers:
@@ -241,7 +244,7 @@ class BlobTracker:
             if tr.last_seen != self.frame - 1 or tr.cells.size == 0:
                 continue
             for c, blob in enumerate(blobs):
-                if matched.get(r) == c or not _boxes_touch(blob, tr.points, 1e-6):
+                if matched.get(r) == c or not _boxes_touch(blob, *tr.box):
                     continue
                 common = _overlap(tr.cells, blob.cells)
                 if common > 0 and common >= self.claim_share * min(tr.cells.size, blob.cell_count):
