@@ -15,7 +15,7 @@ Accuracy (``run_accuracy``): pixel assignment between the two people of
 to the right person (tracks mapped to people by majority overlap over the whole run, so
 an identity swap would count as wrong), mean and minimum over the frames where both
 people are present and some pixel is assigned; ``precision``/``recall`` of the assigned
-pixels as foreground against the renderer's person image; ``id_swaps`` = frames whose own
+pixels as foreground against the renderer's person image (and ``iou``); ``id_swaps`` = frames whose own
 majority mapping disagrees with the whole run's. Moving cells from the HMM grid (for the
 top view after 5 frames of the empty room: the people stand still from frame 0) or from
 the perfect mask of (a); the exclusion principle's bodies: the previous frame's
@@ -169,13 +169,14 @@ def _score(run, frames_from=0, frames_to=None) -> dict:
     lut = np.zeros(max([int(a.max()) for a, _, _ in run] + list(mapping) + [0]) + 1, np.int64)
     for track, person in mapping.items():
         lut[track] = person
-    accuracy, precision, recall, swaps = [], [], [], 0
+    accuracy, precision, recall, iou, swaps = [], [], [], [], 0
     for assigned, truth, present in run:
         if not present.all():
             continue
-        p, r, _ = foreground_scores(assigned > 0, truth > 0)
+        p, r, i = foreground_scores(assigned > 0, truth > 0)
         precision.append(p)
         recall.append(r)
+        iou.append(i)
         scored = (truth > 0) & (assigned > 0)
         if scored.any():
             accuracy.append(pixel_assignment_accuracy(lut[assigned], truth, scored))
@@ -185,7 +186,7 @@ def _score(run, frames_from=0, frames_to=None) -> dict:
             "accuracy_mean_%": 100 * float(np.mean(accuracy)) if accuracy else float("nan"),
             "accuracy_min_%": 100 * float(np.min(accuracy)) if accuracy else float("nan"),
             "precision_%": 100 * float(np.nanmean(precision)), "recall_%": 100 * float(np.nanmean(recall)),
-            "id_swaps": swaps}
+            "iou_%": 100 * float(np.nanmean(iou)), "id_swaps": swaps}
 
 
 def run_accuracy() -> list[dict]:

@@ -173,12 +173,13 @@ def observations_from_depth(
     if set(centers) - set(tracks) or set(predicted) - set(tracks):
         raise ValueError(f"centers and predicted may only name tracked ids {ids}, got "
                          f"{sorted(set(centers) - set(tracks))} {sorted(set(predicted) - set(tracks))}")
+    assigned = {c.name: np.zeros((c.height, c.width), np.int32) for c in cameras}
+    pixels_of = {tid: {} for tid in ids}
+    points_of = {tid: {} for tid in ids}
+    if not ids:
+        return {}, assigned
     if states is None:
         states = np.where(labels > 0, M, E).astype(np.uint8)
-    assigned = {c.name: np.zeros((c.height, c.width), np.int32) for c in cameras}
-    observations = {tid: Observation(tid, {}, {}) for tid in ids}
-    if not ids:
-        return observations, assigned
     codes = _label_codes(labels, tracks, ids)
     label_of_cell = np.append(labels.reshape(-1), 0)  # index -1 (no cell) reads the appended 0
     for camera in cameras:
@@ -198,9 +199,9 @@ def observations_from_depth(
         assigned[camera.name].reshape(-1)[pixels] = owner
         for tid in ids:
             mine = owner == tid
-            observations[tid].pixels[camera.name] = pixels[mine]
-            observations[tid].camera_points[camera.name] = points[mine]
-    return observations, assigned
+            pixels_of[tid][camera.name] = pixels[mine]
+            points_of[tid][camera.name] = points[mine]
+    return {tid: Observation(tid, pixels_of[tid], points_of[tid]) for tid in ids}, assigned
 
 
 def _distances(points, code, ids, predicted, fallback) -> np.ndarray:

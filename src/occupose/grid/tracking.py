@@ -213,6 +213,8 @@ class BlobTracker:
             points = np.concatenate([blobs[c].centers[i] for c, i in zip(mine, owned[tr.track_id])])
             order = np.argsort(cells, kind="stable")
             tr.cells, tr.points = cells[order], points[order]
+            tr.cells.setflags(write=False)
+            tr.points.setflags(write=False)
             tr.box = (tr.points.min(axis=0), tr.points.max(axis=0))
             self._measure(tr, tr.points.mean(axis=0))
         for c, claimers in claims.items():
