@@ -21,8 +21,10 @@ from occupose.grid._label_kernels import label_cells
 from occupose.grid.spec import GridSpec
 
 #: Defaults for 5 cm cells. One depth camera marks mostly the body's visible surface as
-#: moving: a standing person is ~300-600 cells, a person seated behind a table (upper body
-#: only) ~100; a blob must reach ``min_top`` above the floor and span ``min_height``.
+#: moving: on the HMM grid of the synthetic scenes a walking person is ~300-500 cells, a
+#: person seated behind a table (upper body only, top ~1.3 m) ~150-230, a person under a
+#: ceiling camera ~60-120. A blob must also reach ``min_top`` above the floor and span
+#: ``min_height``; pieces in one column are joined first (``join_m``, see blobs_from_mask).
 MIN_CELLS = 40
 MIN_HEIGHT = 0.3
 MIN_TOP = 0.7
