@@ -7,9 +7,17 @@ import platform
 import time
 from pathlib import Path
 
-from benchmarks import bench_body, bench_filters, bench_grid, bench_likelihood, bench_render, format_table
+from benchmarks import (
+    bench_blobs,
+    bench_body,
+    bench_filters,
+    bench_grid,
+    bench_likelihood,
+    bench_render,
+    format_table,
+)
 
-BENCHMARKS = [bench_render, bench_grid, bench_body, bench_likelihood, bench_filters]
+BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters]
 
 
 def machine() -> str:
