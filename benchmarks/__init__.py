@@ -2,6 +2,27 @@
 
 from __future__ import annotations
 
+import time
+
+
+def median_seconds(function, repeats: int, warmup: int = 3, clock=time.perf_counter) -> tuple[float, float]:
+    """(median, min) seconds of ``repeats`` calls of ``function()`` after ``warmup`` calls."""
+    for _ in range(warmup):
+        function()
+    times = []
+    for _ in range(repeats):
+        start = clock()
+        function()
+        times.append(clock() - start)
+    times.sort()
+    return times[len(times) // 2], times[0]
+
+
+def median_ms(function, repeats: int, warmup: int = 3, clock=time.perf_counter) -> tuple[float, float]:
+    """(median, min) milliseconds per call, as :func:`median_seconds`."""
+    median, best = median_seconds(function, repeats, warmup, clock)
+    return 1e3 * median, 1e3 * best
+
 
 def format_table(title: str, rows: list[dict]) -> str:
     """A markdown table of benchmark rows (dicts with the same keys), floats to 2 decimals."""

@@ -13,21 +13,16 @@ import time
 import numba
 import numpy as np
 
+from benchmarks import median_seconds
 from occupose.body import BODY_MODELS, capsules_from_poses, joints_from_poses, pose_from_joints
 from occupose.synth.motion import MotionBuilder
 
 TITLE = "Body models: forward kinematics and pose fitting (microseconds per call)"
 
 
-def _median_us(function, repeats: int, warmup: int = 5) -> tuple[float, float]:
-    for _ in range(warmup):
-        function()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return 1e6 * float(np.median(times)), 1e6 * float(np.min(times))
+def _median_us_call(function, repeats: int, warmup: int = 5) -> tuple[float, float]:
+    median, best = median_seconds(function, repeats, warmup)
+    return 1e6 * median, 1e6 * best
 
 
 def run(repeats: int = 200) -> list[dict]:
@@ -42,7 +37,7 @@ def run(repeats: int = 200) -> list[dict]:
                 poses = rng.uniform(model.limits[:, 0], model.limits[:, 1], size=(count, model.num_dofs))
                 for case, function in (("capsules_from_poses", capsules_from_poses),
                                        ("joints_from_poses", joints_from_poses)):
-                    median, best = _median_us(lambda: function(model, poses), repeats)
+                    median, best = _median_us_call(lambda: function(model, poses), repeats)
                     rows.append({"case": case, "model": name, "particles": count, "threads": threads,
                                  "us_median": median, "us_min": best})
     numba.set_num_threads(all_threads)

@@ -20,11 +20,11 @@ foreground (and stay so).
 from __future__ import annotations
 
 import os
-import time
 
 import numba
 import numpy as np
 
+from benchmarks import median_ms
 from occupose.grid.baseline import DepthBackgroundSubtractor
 from occupose.grid.occupancy import OccupancyGrid, cells_from_depth, foreground_from_grid, spec_from_cameras
 from occupose.grid.spec import GridSpec
@@ -37,17 +37,6 @@ TITLE = "Occupancy grid: one update and back-projection (ms per frame)"
 ACCURACY_TITLE = "Occupancy grid (HMM) vs per-pixel MOG2 on depth: foreground per scenario"
 SCENARIOS = ("no_occlusion", "moved_chair", "sit_behind_table", "two_people_crossing")
 MIN_PERSON_PIXELS = 500
-
-
-def _median_ms(function, repeats: int, warmup: int = 3) -> tuple[float, float]:
-    for _ in range(warmup):
-        function()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return 1e3 * float(np.median(times)), 1e3 * float(np.min(times))
 
 
 def run(repeats: int = 50) -> list[dict]:
@@ -69,7 +58,7 @@ def run(repeats: int = 50) -> list[dict]:
         for name, spec, cameras in cases:
             grid = OccupancyGrid(spec, cameras)
             depths = {cam.name: frame.depth[cam.name] for cam in cameras}
-            median, best = _median_ms(lambda: grid.update(depths), repeats)
+            median, best = median_ms(lambda: grid.update(depths), repeats)
             rows.append({"case": name, "cells": spec.num_cells, "cameras": len(cameras), "threads": threads,
                          "ms_median": median, "ms_min": best, "load_1min": os.getloadavg()[0]})
         grid = OccupancyGrid(box, [front])
@@ -80,7 +69,7 @@ def run(repeats: int = 50) -> list[dict]:
             ("cells_from_depth (with states)", lambda: cells_from_depth(depth, front, box, grid.states)),
             ("foreground_from_grid", lambda: foreground_from_grid(grid.states, box, depth, front)),
         ):
-            median, best = _median_ms(function, repeats)
+            median, best = median_ms(function, repeats)
             rows.append({"case": name, "cells": box.num_cells, "cameras": 1, "threads": threads,
                          "ms_median": median, "ms_min": best, "load_1min": os.getloadavg()[0]})
     numba.set_num_threads(all_threads)

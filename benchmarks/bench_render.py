@@ -10,11 +10,11 @@ noise and the per-part ground-truth visibility renders).
 
 from __future__ import annotations
 
-import time
 
 import numba
 import numpy as np
 
+from benchmarks import median_ms
 from occupose.synth.body import primitives_from_joints, random_body_shape
 from occupose.synth.generate import frames
 from occupose.synth.noise import apply_noise
@@ -23,17 +23,6 @@ from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 
 TITLE = "Synthetic rendering, 640x480 (ms per frame)"
-
-
-def _median_ms(function, repeats: int, warmup: int = 3) -> tuple[float, float]:
-    for _ in range(warmup):
-        function()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return 1e3 * float(np.median(times)), 1e3 * float(np.min(times))
 
 
 def run(repeats: int = 30) -> list[dict]:
@@ -58,17 +47,17 @@ def run(repeats: int = 30) -> list[dict]:
                 ("full render", lambda: render_camera(everything, cam), len(everything)),
                 ("background + people", lambda: render_camera(moving, cam, background=background), len(moving)),
             ):
-                median, best = _median_ms(function, repeats)
+                median, best = median_ms(function, repeats)
                 rows.append({"case": case, "people": count, "primitives": k, "threads": threads,
                              "ms_median": median, "ms_min": best})
     numba.set_num_threads(all_threads)
     depth = render_camera(concat([scenario.static, people(1)]), cam).depth
     for model in ("structured_light", "tof"):
         rng = np.random.default_rng(0)
-        median, best = _median_ms(lambda: apply_noise(depth, model, rng, fx=cam.fx), repeats)
+        median, best = median_ms(lambda: apply_noise(depth, model, rng, fx=cam.fx), repeats)
         rows.append({"case": f"noise {model}", "people": 1, "primitives": 0, "threads": all_threads,
                      "ms_median": median, "ms_min": best})
-    median, best = _median_ms(lambda: next(frames(scenario, indices=[60])), max(5, repeats // 3))
+    median, best = median_ms(lambda: next(frames(scenario, indices=[60])), max(5, repeats // 3))
     rows.append({"case": "whole synthetic frame with ground truth", "people": 1, "primitives": 16 + len(scenario.static),
                  "threads": all_threads, "ms_median": median, "ms_min": best})
     return rows
