@@ -1,0 +1,538 @@
+"""The per-frame pipeline for any number of people and cameras (DESIGN.md, "The pipeline").
+
+One :class:`Tracker` holds everything that lives across frames: the occupancy grid
+(stage 1), the blob tracker (stage 2) and one :class:`_Person` per tracked blob (stage 3:
+a body model, a particle filter and, for methods with occlusion handling, the visible /
+hidden state machine of :mod:`occupose.occlusion`). :meth:`Tracker.update` takes one frame
+of depth images and returns every tracked person's 15 canonical joints, each flagged
+visible (estimated from this frame's data) or not (carried from memory).
+
+A frame:
+
+1. the grid takes the depth images; cells inside a tracked person's body are *held*
+   (no moving -> static transition), so a person standing or sitting still is not
+   absorbed into the background (with the paper's psi they would be after ~77 frames);
+2. moving cells are labelled into blobs, blobs tracked (ids persist);
+3. every tracked blob's pixels go to its person; where people touch, each pixel goes
+   to the nearest predicted body (exclusion principle; a new person's body is made of
+   its previous points, see :func:`occupose.grid.observation.predicted_from_tracks`);
+4. per person: a new track is initialised once its blob is tall enough (body size from
+   its points, a search over heading and a standing or sitting start); a known one first
+   runs the occlusion check (its previous estimate moved to the blob's new centre of
+   mass), then the filter on the visible subtree;
+5. tracks whose blob has been gone for longer than the blob tracker's gap end.
+
+Methods (:data:`METHODS`) are named presets of filter, budget and occlusion handling;
+every setting can be overridden.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from occupose.body import (
+    BodyModel,
+    body_model,
+    capsules_from_poses,
+    dims_from_observation,
+    joints_from_poses,
+    pose_from_joints,
+)
+from occupose.camera import Camera, pixels_from_points
+from occupose.grid.blobs import blobs_from_mask
+from occupose.grid.observation import observations_from_depth, predicted_from_tracks
+from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
+from occupose.grid.tracking import BlobTracker
+from occupose.joints import JOINT_INDEX, NUM_JOINTS
+from occupose.likelihood import View, observation_from_views, point_distances
+from occupose.occlusion import OcclusionState
+from occupose.pose import PoseEstimator, PoseProblem
+from occupose.synth import motion as procedural
+
+
+@dataclass(frozen=True)
+class Method:
+    """A tracking method: what runs in stage 3 for each person.
+
+    filter : name in occupose.filters.FILTERS; particles : particles per person
+    layers : annealing layers (an int, or one per partitioned-sampling stage; None for
+        filters without layers)
+    likelihood : name in occupose.likelihood.LIKELIHOODS
+    occlusion : whether hidden parts are detected and left out (occupose.occlusion)
+    model : "full", "upper" or "auto" (``upper`` for a camera looking steeply down)
+    max_points : most observed points per person and frame given to the likelihood
+    """
+
+    filter: str
+    particles: int
+    layers: int | tuple[int, ...] | None = None
+    likelihood: str = "points+free"
+    occlusion: bool = False
+    model: str = "auto"
+    max_points: int = 1000
+
+    @property
+    def filter_options(self) -> dict:
+        return {} if self.layers is None else {"num_layers": self.layers}
+
+
+#: The methods of the papers with their budgets. ``ours`` is the first paper's filter
+#: (annealed layers within partitions, 200 particles; its "5 layers" read as 5 layers
+#: spread over the 3 partitioned-sampling stages, 3 on the root and 1 each on the arms
+#: and the legs: 1000 likelihood evaluations per frame) with occlusion handling; ``apf``
+#: and ``ps`` its baselines (2000 evaluations each, no occlusion handling); ``part-based``
+#: the second paper's upper-body filter. All use the same likelihood.
+METHODS: dict[str, Method] = {
+    "ours": Method("apf+ps", 200, (3, 1, 1), occlusion=True),
+    "apf": Method("apf", 200, 10),
+    "ps": Method("ps", 2000),
+    "part-based": Method("part-based", 400, model="upper"),
+}
+
+#: A camera whose optical axis points down more steeply than this (radians below the
+#: horizontal) is a ceiling camera: ``model="auto"`` picks the upper-body model.
+STEEP_DOWN = np.deg2rad(60.0)
+#: A blob starts a person once its top is at least this high, metres (a seated adult's head),
+MIN_INIT_TOP = 1.0
+#: it has at least this many observed points,
+MIN_INIT_POINTS = 200
+#: and it has been so for this many frames in a row: the body size is measured on their
+#: points pooled (the grid extracts a newly moving body over a few frames, so the first
+#: frames' points fall short of the head).
+INIT_FRAMES = 5
+#: Headings tried when a person starts, radians.
+INIT_HEADINGS = np.linspace(-np.pi, np.pi, 12, endpoint=False)
+#: Seat height of the sitting start, as a share of the stature (0.45 m for 1.75 m).
+SEAT_SHARE = 0.26
+#: Random perturbations of each start candidate scored at initialisation.
+INIT_SAMPLES = 40
+#: Filter steps run on a new person's first observation (to settle the start pose).
+INIT_STEPS = 3
+#: Spread (std) of a new person's particles around the chosen start: root x, y, z (m),
+#: heading (rad), other angles (rad).
+INIT_SPREAD = (0.05, 0.05, 0.05, 0.15, 0.1)
+#: Hip flexions and knee bends tried when placing hidden legs (:func:`planted_legs`), radians.
+PLANT_HIP = np.linspace(0.0, 1.8, 19)
+PLANT_KNEE = np.linspace(0.0, 2.2, 23)
+#: A part is hidden behind a measured surface nearer than its sphere by more than this, metres.
+HIDDEN_MARGIN = 0.1
+
+
+def _model_for(cameras: Sequence[Camera]) -> str:
+    """'upper' when every camera looks down more steeply than STEEP_DOWN, else 'full'."""
+    steep = [np.arcsin(np.clip(-c.world_from_camera[2, 2], -1, 1)) > STEEP_DOWN for c in cameras]
+    return "upper" if all(steep) else "full"
+
+
+def _part_tree(model: BodyModel) -> tuple[list[int], list[np.ndarray]]:
+    """Parent part of each part (-1 for the root) and the DOFs that place each part relative
+    to its parent (the model's weight groups), for the occlusion state machine.
+
+    A part's parent is the part owning the DOFs of the nearest ancestor node with DOFs.
+    Raises ValueError for a model whose parts are not in parent-first order.
+    """
+    owner = np.full(model.num_dofs, -1)
+    for k, group in enumerate(model.weight_groups):
+        owner[group.dofs] = k
+    node_part = np.full(len(model.node_names), -1)
+    for d in range(model.num_dofs):
+        node_part[model.dof_node[d]] = owner[d]
+    parents = []
+    for group in model.weight_groups:
+        node = int(model.dof_node[group.dofs].min())
+        parent, up = -1, int(model.parents[node])
+        while up >= 0 and parent < 0:
+            parent, up = int(node_part[up]), int(model.parents[up])
+        parents.append(parent)
+    if any(p >= k for k, p in enumerate(parents)) or parents.count(-1) != 1:
+        raise ValueError(f"body model {model.name!r} has no parent-first part tree (parents {parents})")
+    return parents, [np.asarray(g.dofs) for g in model.weight_groups]
+
+
+def _joint_parts(model: BodyModel) -> list[np.ndarray]:
+    """For each canonical joint, the parts whose DOFs place it (empty where the model does
+    not report the joint): a joint is visible when all of them are."""
+    owner = np.full(model.num_dofs, -1)
+    for k, group in enumerate(model.weight_groups):
+        owner[group.dofs] = k
+    out = []
+    for node in model.joint_nodes:
+        if node < 0:
+            out.append(np.zeros(0, int))
+            continue
+        chain, up = [], int(model.parents[node])
+        chain.append(int(node)) if up < 0 else None  # the root is placed by its own DOFs
+        while up >= 0:
+            chain.append(up)
+            up = int(model.parents[up])
+        out.append(np.unique(owner[np.isin(model.dof_node, chain)]))
+    return out
+
+
+def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsule_part: np.ndarray,
+                          num_parts: int, depths: Mapping[str, np.ndarray], owners: Mapping[str, np.ndarray],
+                          cameras: Sequence[Camera], track_id: int, n: int = 5,
+                          margin: float = HIDDEN_MARGIN) -> np.ndarray:
+    """Which parts have more than half of their spheres hidden from every camera.
+
+    A sphere (``n`` per capsule, along its axis) is hidden from a camera when it projects
+    outside the image, or onto a pixel whose measured surface is nearer than the sphere's
+    front (its centre minus the capsule's radius there) by more than ``margin`` and that
+    pixel does not belong to this person (``owners`` is not ``track_id``): the person's
+    own body in front of a part (an arm across the chest) does not hide it, furniture
+    and other people do. A pixel without a measurement hides nothing.
+
+    This is the test of the paper's III-D with the depth images in place of the grid's
+    cell visibility (:func:`occupose.occlusion.hidden_parts`): a sphere on a limb's axis
+    lies a few centimetres behind the person's own measured surface, in a cell the grid
+    calls hidden, so the grid test hides visible parts (the paper notes this for seated
+    legs); the pixel's owner tells the person's own surface from the scene's.
+
+    a, b : (C, 3) capsule ends of one pose, metres, world; radii : (C, 2) metres
+    capsule_part : (C,) part index; depths : camera name -> (H, W) float32 metres
+    owners : camera name -> (H, W) int track id of each pixel (0 = nobody)
+    Returns (num_parts,) bool.
+    """
+    t = (np.arange(n) + 0.5) / n
+    centres = (a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]).reshape(-1, 3)
+    radius = (radii[:, :1] + t[None, :] * (radii[:, 1:] - radii[:, :1])).reshape(-1)
+    hidden = np.ones(len(centres), bool)
+    for camera in cameras:
+        uv, z = pixels_from_points(centres, camera)
+        uv = np.round(np.nan_to_num(uv, nan=-1.0, posinf=-1.0, neginf=-1.0))
+        u, v = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
+        inside = (z > 0) & (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
+        ui, vi = np.where(inside, u, 0), np.where(inside, v, 0)
+        measured = depths[camera.name][vi, ui]
+        blocked = (measured > 0) & (measured < z - radius - margin) & (owners[camera.name][vi, ui] != track_id)
+        hidden &= ~inside | blocked
+    per_part = np.bincount(np.repeat(capsule_part, n), weights=hidden, minlength=num_parts)
+    total = np.bincount(np.repeat(capsule_part, n), minlength=num_parts)
+    return per_part > 0.5 * np.maximum(total, 1)
+
+
+def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str]) -> np.ndarray:
+    """``pose`` (D,) with the legs of ``sides`` ("left", "right") placed with their feet on
+    the floor: hip flexion and knee bend (abduction and rotation 0) that put the ankle at
+    the model's ankle height, the least bent such leg, the shin near vertical.
+
+    For legs hidden behind furniture: the paper keeps a hidden part's last seen
+    configuration relative to its parent, so straight legs sink through the floor when
+    the person sits down behind a table; feet stay on the floor while standing, sitting
+    down and getting up, so this is where hidden legs are most likely.
+    """
+    pose = np.array(pose, float)
+    hip, knee = np.meshgrid(PLANT_HIP, PLANT_KNEE, indexing="ij")
+    hip, knee = hip.reshape(-1), knee.reshape(-1)
+    for side in sides:
+        dofs = [model.dof_names.index(f"{side}_hip_{n}") for n in ("flex", "abd", "rot")]
+        bend = model.dof_names.index(f"{side}_knee")
+        candidates = np.repeat(pose[None], len(hip), axis=0)
+        candidates[:, dofs] = np.stack([hip, np.zeros_like(hip), np.zeros_like(hip)], axis=1)
+        candidates[:, bend] = knee
+        ankle = joints_from_poses(model, candidates)[:, JOINT_INDEX[f"{side}_ankle"]]
+        cost = np.abs(ankle[:, 2] - model.dims.ankle_height) + 0.05 * np.abs(knee - hip) + 0.01 * knee
+        pose = candidates[int(np.argmin(cost))]
+    return pose
+
+
+@dataclass
+class PersonEstimate:
+    """One tracked person in one frame.
+
+    joints : (15, 3) float64, metres, world; NaN for joints the model does not report
+    visible : (15,) bool, the joint was estimated from this frame's data (False: carried
+        from memory while hidden or while the person's blob is gone)
+    """
+
+    joints: np.ndarray
+    visible: np.ndarray
+
+
+class _Person:
+    """Stage 3 state of one tracked person: model, filter, occlusion state."""
+
+    def __init__(self, model: BodyModel, method: Method, fps: float, rng: np.random.Generator):
+        self.model = model
+        self.method = method
+        self.problem = PoseProblem(model, method.likelihood, fps=fps)
+        self.estimator = PoseEstimator(self.problem, method.filter, method.particles, rng, **method.filter_options)
+        self.occlusion = None
+        if method.occlusion:
+            parents, dofs = _part_tree(model)
+            self.occlusion = OcclusionState(parents, dofs, model.num_dofs)
+        self.joint_parts = _joint_parts(model)
+        self.pose: np.ndarray | None = None
+        self.centroid: np.ndarray | None = None
+        self.part_visible = np.ones(model.num_parts, bool)
+
+    def estimate(self, fresh: bool) -> PersonEstimate:
+        joints = joints_of(self.model, self.pose)
+        visible = np.array([fresh and bool(len(p)) and bool(self.part_visible[p].all()) for p in self.joint_parts])
+        return PersonEstimate(joints, visible & np.isfinite(joints[:, 0]))
+
+    def body_distance(self):
+        """f(points (N, 3)) -> (N,) metres to the surface of this person's current body."""
+        a, b = capsules_from_poses(self.model, self.pose[None])
+        radii = self.model.capsule_radii
+
+        def distance(points: np.ndarray) -> np.ndarray:
+            return point_distances(a, b, radii, points)[0][0].astype(np.float64)
+
+        return distance
+
+
+def joints_of(model: BodyModel, pose: np.ndarray) -> np.ndarray:
+    """(15, 3) canonical joints of one pose (D,) of ``model``."""
+    return joints_from_poses(model, np.asarray(pose, float)[None])[0]
+
+
+def start_candidates(model: BodyModel, centroid: np.ndarray) -> np.ndarray:
+    """(S, D) start poses for a person whose blob is centred at ``centroid`` (3,) metres:
+    standing and (for models with legs) sitting, at every heading of INIT_HEADINGS, the
+    pelvis above the centroid."""
+    poses = []
+    postures = [procedural.standing_pose((0.0, 0.0), 0.0, model.dims)]
+    if any("knee" in n for n in model.dof_names):
+        standing = postures[0]
+        postures.append(procedural.sit_down(standing, SEAT_SHARE * model.dims.height, dims=model.dims)[-1])
+    for posture in postures:
+        fitted = pose_from_joints(model, procedural.joints_from_pose(posture[None], model.dims)[0])
+        for heading in INIT_HEADINGS:
+            pose = fitted.copy()
+            pose[model.dof_names.index("heading")] = heading
+            poses.append(pose)
+    poses = np.array(poses)
+    poses[:, 0:2] = centroid[:2]  # pelvis above the blob's centre; the filter settles the rest
+    return poses
+
+
+class Tracker:
+    """Skeletons of everyone in view, frame after frame (see the module docstring).
+
+    cameras : Camera or sequence of Camera (unique names); fps : frames per second
+    method : a name of :data:`METHODS`; overrides : fields of :class:`Method` to change
+        (filter, particles, layers, likelihood, occlusion, model, max_points)
+    seed : int, seeds every person's filter (person n gets a generator spawned from it)
+    cell : grid cell edge, metres; grid_options : passed to OccupancyGrid
+    max_gap_s : seconds a track survives without its blob
+    """
+
+    def __init__(self, cameras, fps: float, method: str = "ours", *, seed: int = 0, cell: float = 0.05,
+                 grid_options: Mapping | None = None, max_gap_s: float = 1.0, **overrides):
+        if method not in METHODS:
+            raise ValueError(f"unknown method {method!r}; valid names: {', '.join(METHODS)}")
+        unknown = set(overrides) - set(Method.__dataclass_fields__)
+        if unknown:
+            raise ValueError(f"unknown method setting(s) {sorted(unknown)}; valid: {sorted(Method.__dataclass_fields__)}")
+        self.method = replace(METHODS[method], **{k: v for k, v in overrides.items() if v is not None})
+        self.method_name = method
+        cameras = [cameras] if isinstance(cameras, Camera) else list(cameras)
+        self.cameras = cameras
+        self.fps = float(fps)
+        if self.method.model not in ("auto", "full", "upper"):
+            raise ValueError(f"model must be 'auto', 'full' or 'upper', got {self.method.model!r}")
+        self.model_name = _model_for(cameras) if self.method.model == "auto" else self.method.model
+        self.spec = spec_from_cameras(cameras, cell=cell)
+        self.grid = OccupancyGrid(self.spec, cameras, **dict(grid_options or {}))
+        self.blobs = BlobTracker(self.fps, max_gap_s)
+        self.people: dict[int, _Person] = {}
+        self._seeds = np.random.SeedSequence(seed)
+        self._previous = {}
+        self._pending: dict[int, list[np.ndarray]] = {}  # points of tracks not yet started
+        self.frame = -1
+        self.seconds = {"grid": 0.0, "blobs": 0.0, "observations": 0.0, "pose": 0.0}
+        self.last_assigned: dict[str, np.ndarray] = {}
+
+    def update(self, depths: Mapping[str, np.ndarray]) -> dict[int, PersonEstimate]:
+        """Take one frame: camera name -> (H, W) float32 depth, metres (0 = no measurement).
+
+        Returns {track id: PersonEstimate} for every person tracked in this frame (seen,
+        or kept through a short disappearance: then every joint has visible False).
+        """
+        self.frame += 1
+        clock = time.perf_counter()
+        self.grid.update(depths)
+        clock = self._tick("grid", clock)
+        labels, blobs = blobs_from_mask(self.grid.moving_mask(), self.spec)
+        seen = self.blobs.update(blobs)
+        states = self.blobs.states
+        for tid in [t for t in self.people if t not in states]:
+            del self.people[tid]  # its blob has been gone for longer than the gap
+        self._pending = {t: p for t, p in self._pending.items() if t in seen}
+        clock = self._tick("blobs", clock)
+        bodies = {t: self.people[t].body_distance() for t in seen if t in self.people}
+        bodies |= predicted_from_tracks(states, self._previous, self.fps, ids=[t for t in seen if t not in bodies])
+        observations, assigned = observations_from_depth(
+            depths, self.cameras, self.spec, labels, seen, states=self.grid.states,
+            centers={t: states[t].centroid for t in seen}, predicted=bodies)
+        self._previous, self.last_assigned = observations, assigned
+        clock = self._tick("observations", clock)
+        out = {}
+        for tid in seen:
+            person = self.people.get(tid)
+            if person is None:
+                person = self._start(tid, observations[tid], depths, assigned, seen[tid])
+                if person is None:
+                    continue
+                out[tid] = person.estimate(True)
+            else:
+                out[tid] = self._step(tid, person, observations[tid], depths, assigned, states[tid].centroid)
+        for tid, person in self.people.items():
+            if tid not in seen:
+                out[tid] = person.estimate(False)
+        self._tick("pose", clock)
+        return dict(sorted(out.items()))
+
+    def _tick(self, stage: str, start: float) -> float:
+        now = time.perf_counter()
+        self.seconds[stage] += now - start
+        return now
+
+    def _views(self, pixels: Mapping[str, np.ndarray], depths) -> list[View]:
+        views = []
+        for camera in self.cameras:
+            mask = np.zeros(camera.height * camera.width, bool)
+            mask[pixels[camera.name]] = True
+            views.append(View(camera, depths[camera.name], mask.reshape(camera.height, camera.width)))
+        return views
+
+    def _start(self, tid, observation, depths, assigned, blob) -> _Person | None:
+        """A new person from its blob, or None while the blob has not been person-like for
+        INIT_FRAMES frames."""
+        points = observation.points
+        if blob.top < MIN_INIT_TOP or len(points) < MIN_INIT_POINTS:
+            self._pending.pop(tid, None)
+            return None
+        pending = self._pending.setdefault(tid, [])
+        pending.append(points)
+        if len(pending) < INIT_FRAMES:
+            return None
+        size = dims_from_observation(np.concatenate(self._pending.pop(tid)))
+        rng = np.random.default_rng(self._seeds.spawn(1)[0])
+        standing = _Person(body_model(self.model_name, size.dims, size.girth), self.method, self.fps, rng)
+        views = self._views(observation.pixels, depths)
+        likelihood_obs = observation_from_views(views, self.method.max_points)
+        problem = standing.problem
+        problem.set_observation(likelihood_obs)
+        candidates = start_candidates(standing.model, np.mean(points, axis=0))
+        spread = self._spread(standing.model)
+        samples = np.repeat(candidates, INIT_SAMPLES, axis=0)
+        samples += rng.standard_normal(samples.shape) * spread
+        samples = np.clip(samples, problem.limits[:, 0], problem.limits[:, 1])
+        best = samples[int(np.argmax(problem.log_likelihood(samples).sum(axis=1)))]
+        standing.estimator.initialise(best, spread)
+        for _ in range(INIT_STEPS):
+            best = standing.estimator.step(likelihood_obs)
+        standing.pose = best
+        standing.centroid = np.asarray(blob.centroid, float)
+        self.people[tid] = standing
+        return standing
+
+    @staticmethod
+    def _spread(model: BodyModel) -> np.ndarray:
+        root_xyz, heading, angle = INIT_SPREAD[0], INIT_SPREAD[3], INIT_SPREAD[4]
+        spread = np.where(model.angular, angle, root_xyz)
+        spread[model.dof_names.index("heading")] = heading
+        return spread
+
+    def _step(self, tid, person: _Person, observation, depths, assigned, centroid) -> PersonEstimate:
+        active = scale = None
+        if person.occlusion is not None:
+            moved = person.pose.copy()
+            moved[:2] += np.asarray(centroid[:2]) - person.centroid[:2]
+            model = person.model
+
+            def hidden(pose):
+                a, b = capsules_from_poses(model, pose[None])
+                return hidden_parts_in_views(a[0], b[0], model.capsule_radii, model.capsule_part, model.num_parts,
+                                             depths, assigned, self.cameras, tid)
+
+            person.part_visible = person.occlusion.update(moved, hidden)
+            if person.occlusion.suspended:
+                return person.estimate(False)
+            active, scale = person.occlusion.active_dofs(), person.occlusion.diffusion_scale()
+            person.problem.hidden_parts = ~person.part_visible
+        person.centroid = np.asarray(centroid, float)
+        if not any(len(p) for p in observation.pixels.values()):
+            return person.estimate(False)
+        views = self._views(observation.pixels, depths)
+        pose = person.estimator.step(observation_from_views(views, self.method.max_points),
+                                     active=active, diffusion_scale=scale)
+        if person.occlusion is not None:
+            person.occlusion.remember(pose)
+            pose = person.occlusion.with_memory(pose)
+            hidden_legs = [side for side in ("left", "right")
+                           if f"{side}_thigh" in person.model.part_names
+                           and not person.part_visible[person.model.part_names.index(f"{side}_thigh")]]
+            if hidden_legs:
+                pose = planted_legs(person.model, pose, hidden_legs)
+                person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
+        person.pose = pose
+        return person.estimate(True)
+
+
+@dataclass
+class TrackingResult:
+    """The output of :func:`track_recording`.
+
+    tracks : {track id: (joints (T, 15, 3) float64 metres, NaN where not tracked,
+        visible (T, 15) bool)}
+    seconds : seconds spent per stage (grid, blobs, observations, pose) and ``total``
+        (all frames, reading excluded), ``startup`` (first frame, numba compilation included)
+    fps : frames per second of tracking, the first frame (start-up) excluded
+    num_frames : frames tracked; settings : the method's settings as run (for summaries)
+    """
+
+    tracks: dict[int, tuple[np.ndarray, np.ndarray]]
+    seconds: dict[str, float] = field(default_factory=dict)
+    fps: float = 0.0
+    num_frames: int = 0
+    settings: dict = field(default_factory=dict)
+
+
+def track_frames(tracker: Tracker, frames, num_frames: int, progress=None) -> TrackingResult:
+    """Run ``tracker`` over ``frames`` (an iterable of objects with ``.index`` and ``.depth``,
+    e.g. ``Recording.frames()``), ``num_frames`` of them. ``progress`` : callable(n) called
+    after each frame, or None."""
+    joints = {}
+    visible = {}
+    startup = 0.0
+    total = 0.0
+    for n, frame in enumerate(frames):
+        start = time.perf_counter()
+        estimates = tracker.update(frame.depth)
+        spent = time.perf_counter() - start
+        if n == 0:
+            startup = spent
+        else:
+            total += spent
+        for tid, est in estimates.items():
+            if tid not in joints:
+                joints[tid] = np.full((num_frames, NUM_JOINTS, 3), np.nan)
+                visible[tid] = np.zeros((num_frames, NUM_JOINTS), bool)
+            joints[tid][frame.index] = est.joints
+            visible[tid][frame.index] = est.visible
+        if progress is not None:
+            progress(1)
+    seconds = dict(tracker.seconds, total=total, startup=startup)
+    fps = (num_frames - 1) / total if num_frames > 1 and total > 0 else 0.0
+    return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, seconds, fps, num_frames)
+
+
+def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=None, **settings) -> TrackingResult:
+    """Track every person of an open :class:`occupose.recording.Recording`.
+
+    method, seed, settings : as :class:`Tracker` (settings: Method fields, ``cell``,
+    ``grid_options``, ``max_gap_s``); progress : callable(n) after each frame, or None.
+    An empty recording (no frames) gives an empty result.
+    """
+    tracker = Tracker(recording.cameras, recording.fps, method, seed=seed, **settings)
+    result = track_frames(tracker, recording.frames(), recording.num_frames, progress)
+    result.settings = {"method": method, "model": tracker.model_name, "seed": seed,
+                       **{k: getattr(tracker.method, k) for k in Method.__dataclass_fields__}}
+    return result
