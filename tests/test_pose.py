@@ -157,9 +157,6 @@ def test_estimator_rejects_bad_input(walk):
         estimator.step(walk[1][1], diffusion_scale=-np.ones(problem.num_dofs))
 
 
-@pytest.mark.xfail(strict=True, raises=(TypeError, IndexError),
-                   reason="PoseEstimator.step uses `active` for the root drift before the filter checks it: "
-                          "a float or wrong-length mask raises TypeError / IndexError, not ValueError")
 @pytest.mark.parametrize("active", [np.ones(25), np.ones(5, bool)], ids=["float", "wrong-length"])
 def test_step_rejects_a_bad_active_mask(walk, active):
     estimator = _estimator("full", walk[0], "sir", 50, 0)

@@ -93,10 +93,25 @@ class PoseEstimator:
         self.filter.initialise(np.asarray(pose, float), spread)
         self._previous = np.asarray(pose, float).copy()
 
+    def shift(self, offset: np.ndarray) -> None:
+        """Move every particle, the estimate and the velocity memory by ``offset`` (D,), e.g.
+        the root's x, y to where a person reappeared (no velocity is inferred from the jump)."""
+        offset = np.asarray(offset, float)
+        if offset.shape != (self.problem.num_dofs,):
+            raise ValueError(f"offset must have shape ({self.problem.num_dofs},), got {offset.shape}")
+        self.filter.particles = self.filter.particles + offset
+        self.filter.estimate = self.filter.estimate + offset
+        self._previous = self.filter.estimate.copy()
+
     def step(self, observation: Observation, *, active: np.ndarray | None = None,
              diffusion_scale: np.ndarray | None = None) -> np.ndarray:
         """Estimate this frame's pose (D,) from ``observation``; ``active`` (D,) bool freezes
         the other DOFs, ``diffusion_scale`` (D,) widens the search per DOF."""
+        if active is not None:
+            active = np.asarray(active)
+            if active.shape != (self.problem.num_dofs,) or active.dtype != bool:
+                raise ValueError(f"active must be a ({self.problem.num_dofs},) bool array, got "
+                                 f"{active.dtype} {active.shape}")
         self.problem.set_observation(observation)
         current = self.filter.estimate
         if self.velocity_damping > 0 and current is not None:

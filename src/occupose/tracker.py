@@ -115,6 +115,15 @@ INIT_STEPS = 3
 #: Spread (std) of a new person's particles around the chosen start: root x, y, z (m),
 #: heading (rad), other angles (rad).
 INIT_SPREAD = (0.05, 0.05, 0.05, 0.15, 0.1)
+#: Seconds a track survives without its blob.
+MAX_GAP_S = 3.0
+#: A person gone or suspended walks on at its pelvis's mean velocity over this many last
+#: estimates, at most CARRY_SPEED metres per frame (2 m/s at 30 fps).
+CARRY_FRAMES = 15
+CARRY_SPEED = 0.067
+#: Largest horizontal offset between the pelvis and its blob's centroid kept for placing
+#: a person that is back, metres.
+MAX_ANCHOR = 0.25
 #: Hip flexions and knee bends tried when placing hidden legs (:func:`planted_legs`), radians.
 PLANT_HIP = np.linspace(0.0, 1.8, 19)
 PLANT_KNEE = np.linspace(0.0, 2.2, 23)
@@ -267,8 +276,28 @@ class _Person:
             self.occlusion = OcclusionState(parents, dofs, model.num_dofs)
         self.joint_parts = _joint_parts(model)
         self.pose: np.ndarray | None = None
-        self.centroid: np.ndarray | None = None
+        self.centroid: np.ndarray | None = None  # (3,) its blob's centroid when last seen
+        self.anchor = np.zeros(2)  # pelvis x, y minus its blob's centroid x, y at the last estimate
+        self.lost = False  # gone or suspended since the last estimate
+        self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
         self.part_visible = np.ones(model.num_parts, bool)
+
+    def settle(self, pose: np.ndarray) -> None:
+        """Take a new estimate (D,)."""
+        self.pose = pose
+        anchor = pose[:2] - self.centroid[:2]  # a partly hidden blob's centroid is off: clipped
+        self.anchor = anchor * min(1.0, MAX_ANCHOR / max(float(np.hypot(*anchor)), 1e-12))
+        self.path = (self.path + [pose[:2].copy()])[-CARRY_FRAMES:]
+
+    def carry(self) -> None:
+        """A frame without an estimate (gone or suspended): the pose walks on at the pelvis's
+        mean velocity over the last estimates (at most CARRY_SPEED metres per frame)."""
+        if len(self.path) > 1:
+            step = (self.path[-1] - self.path[0]) / (len(self.path) - 1)
+            step *= min(1.0, CARRY_SPEED / max(float(np.hypot(*step)), 1e-12))
+            self.pose = self.pose.copy()
+            self.pose[:2] += step
+        self.lost = True
 
     def estimate(self, fresh: bool) -> PersonEstimate:
         joints = joints_of(self.model, self.pose)
@@ -319,11 +348,12 @@ class Tracker:
         (filter, particles, layers, likelihood, occlusion, model, max_points)
     seed : int, seeds every person's filter (person n gets a generator spawned from it)
     cell : grid cell edge, metres; grid_options : passed to OccupancyGrid
-    max_gap_s : seconds a track survives without its blob
+    max_gap_s : seconds a track survives without its blob (a person walking behind a tall
+        cabinet is gone for 1-2 s; while gone the pose moves with the blob track's velocity)
     """
 
     def __init__(self, cameras, fps: float, method: str = "ours", *, seed: int = 0, cell: float = 0.05,
-                 grid_options: Mapping | None = None, max_gap_s: float = 1.0, **overrides):
+                 grid_options: Mapping | None = None, max_gap_s: float = MAX_GAP_S, **overrides):
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; valid names: {', '.join(METHODS)}")
         unknown = set(overrides) - set(Method.__dataclass_fields__)
@@ -383,7 +413,8 @@ class Tracker:
             else:
                 out[tid] = self._step(tid, person, observations[tid], depths, assigned, states[tid].centroid)
         for tid, person in self.people.items():
-            if tid not in seen:
+            if tid not in seen:  # gone (behind something): kept, not estimated
+                person.carry()
                 out[tid] = person.estimate(False)
         self._tick("pose", clock)
         return dict(sorted(out.items()))
@@ -428,8 +459,8 @@ class Tracker:
         standing.estimator.initialise(best, spread)
         for _ in range(INIT_STEPS):
             best = standing.estimator.step(likelihood_obs)
-        standing.pose = best
         standing.centroid = np.asarray(blob.centroid, float)
+        standing.settle(best)
         self.people[tid] = standing
         return standing
 
@@ -442,9 +473,17 @@ class Tracker:
 
     def _step(self, tid, person: _Person, observation, depths, assigned, centroid) -> PersonEstimate:
         active = scale = None
+        centroid = np.asarray(centroid, float)
+        if person.lost:  # back after being gone or suspended: start again at the blob
+            offset = np.zeros(person.model.num_dofs)
+            offset[:2] = centroid[:2] + person.anchor - person.pose[:2]
+            person.estimator.shift(offset)
+            person.pose = person.pose + offset
+            person.centroid, person.lost = centroid, False
+        moved = person.pose.copy()
+        moved[:2] += centroid[:2] - person.centroid[:2]
+        person.centroid = centroid
         if person.occlusion is not None:
-            moved = person.pose.copy()
-            moved[:2] += np.asarray(centroid[:2]) - person.centroid[:2]
             model = person.model
 
             def hidden(pose):
@@ -453,11 +492,11 @@ class Tracker:
                                              depths, assigned, self.cameras, tid)
 
             person.part_visible = person.occlusion.update(moved, hidden)
-            if person.occlusion.suspended:
+            if person.occlusion.suspended:  # kept where its blob is, not estimated
+                person.pose, person.lost = moved, True
                 return person.estimate(False)
             active, scale = person.occlusion.active_dofs(), person.occlusion.diffusion_scale()
             person.problem.hidden_parts = ~person.part_visible
-        person.centroid = np.asarray(centroid, float)
         if not any(len(p) for p in observation.pixels.values()):
             return person.estimate(False)
         views = self._views(observation.pixels, depths)
@@ -472,7 +511,7 @@ class Tracker:
             if hidden_legs:
                 pose = planted_legs(person.model, pose, hidden_legs)
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
-        person.pose = pose
+        person.settle(pose)
         return person.estimate(True)
 
 

@@ -1,0 +1,219 @@
+"""The tracker end to end on short synthetic scenes, its parts, and bad input."""
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from occupose.body import body_model, capsules_from_poses, joints_from_poses, standing_pose
+from occupose.camera import Camera, look_at, raw_depth_from_metres
+from occupose.cli import main
+from occupose.joints import JOINT_INDEX, JOINTS
+from occupose.metrics import frame_errors, joint_errors, read_tracks_csv
+from occupose.recording import Recording, RecordingWriter
+from occupose.synth.generate import frames
+from occupose.synth.scenarios import build_scenario
+from occupose.tracker import (
+    INIT_FRAMES,
+    METHODS,
+    Tracker,
+    _joint_parts,
+    _part_tree,
+    hidden_parts_in_views,
+    planted_legs,
+    track_frames,
+)
+
+
+@pytest.fixture(scope="module")
+def walk():
+    """The first 60 frames of no_occlusion (procedural motion): frames and ground truth."""
+    scenario = build_scenario("no_occlusion", use_mocap=False)
+    rendered = list(frames(scenario, seed=0, num_frames=60))
+    return scenario, rendered
+
+
+def _camera() -> Camera:
+    return Camera("cam", 160, 120, 120.0, 120.0, 79.5, 59.5, 0.001,
+                  look_at(eye=(0.0, -3.0, 1.2), target=(0.0, 0.0, 1.0)))
+
+
+# ------------------------------------------------------------------------------ end to end
+
+
+def test_tracks_the_walk_from_its_blob_without_a_start_pose(walk):
+    scenario, rendered = walk
+    tracker = Tracker(scenario.cameras, scenario.fps, "ours", seed=0)
+    result = track_frames(tracker, rendered, len(rendered))
+    assert list(result.tracks) == [1]
+    joints, visible = result.tracks[1]
+    tracked = np.flatnonzero(np.isfinite(joints[:, 0, 0]))
+    # the blob is extracted within a few frames; the person starts after INIT_FRAMES of them
+    assert tracked[0] <= INIT_FRAMES + 5 and np.all(np.diff(tracked) == 1) and tracked[-1] == len(rendered) - 1
+    gt = np.stack([f.joints[0] for f in rendered])
+    errors = frame_errors(joint_errors(gt[tracked], joints[tracked]))
+    assert errors.mean() < 0.10  # measured 7.7 cm
+    assert np.all(visible[tracked])  # nothing hides the walker
+    assert result.fps > 0 and set(result.seconds) >= {"grid", "blobs", "observations", "pose", "total"}
+
+
+def test_same_seed_same_tracks(walk):
+    scenario, rendered = walk
+    runs = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=s), rendered[:20], 20).tracks
+            for s in (3, 3, 4)]
+    assert np.array_equal(runs[0][1][0], runs[1][1][0], equal_nan=True)
+    assert not np.allclose(runs[0][1][0], runs[2][1][0], equal_nan=True)
+
+
+def test_a_room_without_people_gives_no_tracks():
+    camera = _camera()
+    tracker = Tracker([camera], 30.0)
+    wall = np.full((camera.height, camera.width), 3.5, np.float32)
+    for _ in range(10):
+        assert tracker.update({"cam": wall}) == {}
+    for _ in range(3):  # every pixel invalid (a sensor blinded): no crash, nobody
+        assert tracker.update({"cam": np.zeros_like(wall)}) == {}
+
+
+def test_a_camera_dropping_out_keeps_the_person_and_carries_it(walk):
+    scenario, rendered = walk
+    tracker = Tracker(scenario.cameras, scenario.fps, "ours", seed=0)
+    name = scenario.cameras[0].name
+    for f in rendered[:30]:
+        out = tracker.update(f.depth)
+    assert list(out) == [1] and out[1].visible.all()
+    blind = {name: np.zeros_like(rendered[30].depth[name])}
+    for _ in range(5):
+        out = tracker.update(blind)
+        assert list(out) == [1] and not out[1].visible.any()  # kept, carried, flagged not visible
+    for f in rendered[35:45]:
+        out = tracker.update(f.depth)
+    assert list(out) == [1] and out[1].visible.all()
+    error = frame_errors(joint_errors(rendered[44].joints[0][None], out[1].joints[None]))[0]
+    assert error < 0.15  # back on the person after the drop-out
+
+
+def test_bad_settings_are_refused():
+    camera = _camera()
+    with pytest.raises(ValueError, match="unknown method 'fast'; valid names: ours, apf, ps, part-based"):
+        Tracker([camera], 30.0, "fast")
+    with pytest.raises(ValueError, match=r"unknown method setting\(s\) \['particle'\]"):
+        Tracker([camera], 30.0, particle=10)
+    with pytest.raises(ValueError, match="model must be 'auto', 'full' or 'upper'"):
+        Tracker([camera], 30.0, model="legs")
+
+
+def test_auto_model_is_upper_for_a_ceiling_camera():
+    front = _camera()
+    ceiling = Camera("top", 160, 120, 120.0, 120.0, 79.5, 59.5, 0.001,
+                     look_at(eye=(0.0, 0.0, 2.9), target=(0.0, 0.01, 0.0)))
+    assert Tracker([front], 30.0).model_name == "full"
+    assert Tracker([ceiling], 30.0).model_name == "upper"
+    assert Tracker([ceiling], 30.0, model="full").model_name == "full"
+    assert METHODS["part-based"].model == "upper"
+
+
+# ------------------------------------------------------------------------------ the parts
+
+
+def test_part_tree_of_the_full_model():
+    model = body_model("full")
+    parents, dofs = _part_tree(model)
+    names = model.part_names
+    named = {names[k]: (names[p] if p >= 0 else None) for k, p in enumerate(parents)}
+    assert named == {"torso": None, "head": "torso", "left_upper_arm": "torso", "left_forearm": "left_upper_arm",
+                     "right_upper_arm": "torso", "right_forearm": "right_upper_arm", "left_thigh": "torso",
+                     "left_shin": "left_thigh", "right_thigh": "torso", "right_shin": "right_thigh"}
+    assert sorted(np.concatenate(dofs).tolist()) == list(range(model.num_dofs))
+
+
+def test_joints_are_visible_when_the_parts_placing_them_are():
+    model = body_model("full")
+    parts = {JOINTS[j]: sorted(model.part_names[k] for k in p) for j, p in enumerate(_joint_parts(model))}
+    assert parts["pelvis"] == ["torso"] and parts["left_hip"] == ["torso"]
+    assert parts["left_knee"] == ["left_thigh", "torso"]
+    assert parts["right_ankle"] == ["right_shin", "right_thigh", "torso"]
+    assert parts["head"] == ["head", "torso"]
+    upper = body_model("upper")
+    assert [len(p) for p in _joint_parts(upper)][JOINT_INDEX["left_knee"]] == 0  # not reported
+
+
+def test_hidden_parts_behind_a_surface_that_is_not_the_person():
+    camera = _camera()
+    model = body_model("full")
+    pose = standing_pose(model, (0.0, 0.0), np.pi / 2 + np.pi)  # facing the camera at y = -3
+    a, b = (x[0] for x in capsules_from_poses(model, pose[None]))
+    depth = np.full((camera.height, camera.width), 3.5, np.float32)
+    owners = np.zeros(depth.shape, np.int32)
+    depth[70:, :] = 2.0  # a table top edge in front of the legs (image rows below the hips)
+    args = (a, b, model.capsule_radii, model.capsule_part, model.num_parts, {"cam": depth})
+    hidden = hidden_parts_in_views(*args, {"cam": owners}, [camera], track_id=1)
+    names = [n for n, h in zip(model.part_names, hidden) if h]
+    assert {"left_shin", "right_shin"} <= set(names)
+    assert "torso" not in names and "head" not in names
+    owners[70:, :] = 1  # the same surface is the person's own: nothing is hidden
+    assert not hidden_parts_in_views(*args, {"cam": owners}, [camera], track_id=1).any()
+    far = standing_pose(model, (6.0, 0.0), 0.0)  # outside the image: hidden from the only camera
+    a, b = (x[0] for x in capsules_from_poses(model, far[None]))
+    owners[:] = 0
+    assert hidden_parts_in_views(a, b, model.capsule_radii, model.capsule_part, model.num_parts, {"cam": depth},
+                                 {"cam": owners}, [camera], track_id=1).all()
+
+
+def test_planted_legs_keep_the_feet_on_the_floor():
+    model = body_model("full")
+    pose = standing_pose(model)
+    seated = pose.copy()
+    seated[2] = 0.5  # pelvis at seat height, legs still straight: they would sink into the floor
+    fixed = planted_legs(model, seated, ["left", "right"])
+    joints = joints_from_poses(model, fixed[None])[0]
+    for side in ("left", "right"):
+        assert abs(joints[JOINT_INDEX[f"{side}_ankle"], 2] - model.dims.ankle_height) < 0.03
+        assert fixed[model.dof_names.index(f"{side}_knee")] > 1.2  # bent like a seated leg
+    standing = planted_legs(model, pose, ["left"])
+    assert standing[model.dof_names.index("left_knee")] < 0.15  # a standing leg stays straight
+    assert np.array_equal(standing[model.dof_names.index("right_knee")], pose[model.dof_names.index("right_knee")])
+
+
+# ------------------------------------------------------------------------------ the command line
+
+
+def test_track_command_writes_tracks_and_summary(tmp_path, walk):
+    scenario, rendered = walk
+    rec = tmp_path / "rec"
+    with RecordingWriter(rec, list(scenario.cameras), scenario.fps) as writer:
+        for f in rendered[:25]:
+            writer.write_frame({c.name: raw_depth_from_metres(f.depth[c.name], c) for c in scenario.cameras})
+        writer.write_groundtruth(np.stack([f.joints for f in rendered[:25]]),
+                                 np.stack([f.visible for f in rendered[:25]]), [1])
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["track", str(rec), "--out", str(out), "--particles", "100",
+                                       "--layers", "2,1,1"])
+    assert result.exit_code == 0, result.output
+    assert "1 track(s) in 25 frames" in result.output and "person 1 (track 1) all joints" in result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["method"] == "ours" and summary["particles"] == 100 and summary["layers"] == [2, 1, 1]
+    assert summary["frames"] == 25 and summary["people"] == 1 and summary["fps"] > 0
+    tracks = read_tracks_csv(out / "tracks.csv", 25)
+    assert list(tracks) == [1] and np.isfinite(tracks[1][0][-1]).all()
+
+
+def test_track_command_bad_input(tmp_path):
+    runner = CliRunner()
+    result = runner.invoke(main, ["track", str(tmp_path), "--out", str(tmp_path / "o")])
+    assert result.exit_code != 0 and "recording.json" in result.output
+    config = tmp_path / "c.json"
+    config.write_text("[1, 2]")
+    rec = tmp_path / "rec"
+    with RecordingWriter(rec, [_camera()], 30.0) as writer:
+        writer.write_frame({"cam": np.zeros((120, 160), np.uint16)})
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--config", str(config)])
+    assert result.exit_code != 0 and "the config must be a table of settings" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--layers", "x"])
+    assert result.exit_code != 0 and "--layers must be an integer" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--method", "magic"])
+    assert result.exit_code != 0 and "unknown method 'magic'" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 0 and "nobody was tracked" in result.output
+    assert Recording(rec).num_frames == 1
