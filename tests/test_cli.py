@@ -114,10 +114,13 @@ def test_show_and_score_on_a_folder_that_is_not_a_recording(tmp_path):
         assert result.exit_code != 0 and "recording.json" in result.output and "Traceback" not in result.output
 
 
-def test_demo_pictures_the_last_frame_with_someone_in_view(tmp_path):
-    result = CliRunner().invoke(main, ["demo", "--out", str(tmp_path), "--frames", "60"])
+def test_demo_tracks_scores_and_pictures(tmp_path):
+    result = CliRunner().invoke(main, ["demo", "--out", str(tmp_path), "--frames", "80"])
     assert result.exit_code == 0, result.output
-    assert "1 person(s) in view" in result.output
-    assert list(tmp_path.glob("sit_behind_table_frame0059.png"))
+    assert "ground truth: 1 person(s)" in result.output and "1 track(s) at" in result.output
+    assert "person 1 (track 1) all joints" in result.output  # the Table I rows
+    assert (tmp_path / "sit_behind_table-ours" / "tracks.csv").is_file()
+    pictures = list(tmp_path.glob("sit_behind_table_frame*.png"))
+    assert len(pictures) == 1 and "picture: " in result.output
     result = CliRunner().invoke(main, ["demo", "--out", str(tmp_path / "early"), "--frames", "10"])
     assert result.exit_code == 0 and "nobody is in view in the first 10 frames" in result.output

@@ -240,6 +240,9 @@ def demo_cmd(out, scenario, frames, method) -> None:
                             procedural=True)
     rec = Recording(rec_path)
     gt = rec.groundtruth()
+    if not np.isfinite(gt.joints[..., 0]).any():
+        click.echo(f"nobody is in view in the first {frames} frames: render more with --frames")
+        return
     hidden = 100.0 * (1 - gt.visible[np.isfinite(gt.joints[..., 0])].mean())
     click.echo(f"ground truth: {len(gt.person_ids)} person(s), {hidden:.1f} % of their joint observations hidden "
                "(furniture, other people, their own body, image border)")
