@@ -15,11 +15,14 @@ from occupose.grid.occupancy import (
     FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth, foreground_from_grid,
     frames_until_static, observation_function, spec_from_cameras, transition_matrix,
 )
+from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
 from occupose.grid.spec import GridSpec
 from occupose.joints import JOINT_INDEX
 from occupose.metrics import foreground_scores
 from occupose.synth.generate import frames
-from occupose.synth.noise import depth_std
+from occupose.synth.body import primitives_from_joints, random_body_shape
+from occupose.synth.noise import apply_noise, depth_std
+from occupose.synth.primitives import box, concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 
@@ -29,8 +32,10 @@ FRONT = camera_preset("kinect_v1", world_from_camera=look_at((0.0, 0.0, 1.6), (0
 # ------------------------------------------------------------------ NumPy references
 
 
-def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarray):
-    """One frame of the grid in plain NumPy: (probabilities (N, 3) float64, states (N,), visibility (N,))."""
+def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarray, hold=None):
+    """One frame of the grid in plain NumPy: (probabilities (N, 3) float64, states (N,), visibility (N,)).
+    hold : optional (N,) bool, cells stepped with psi = 0 (the M row renormalised), their O
+        share moved to M first where their MAP state is M."""
     centres = grid.spec.centers().reshape(-1, 3)
     likelihood = np.ones((len(centres), 3))
     covered = np.zeros(len(centres), bool)
@@ -52,7 +57,16 @@ def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarra
         covered |= valid
         with np.errstate(invalid="ignore"):
             seen |= valid & (epsilon >= -band)
-    q = (probabilities.astype(np.float64) @ grid.transition) * likelihood
+    q = probabilities.astype(np.float64) @ grid.transition
+    if hold is not None:
+        held = grid.transition.copy()
+        held[M] = [0.0, held[M, M], held[M, E]] / (held[M, M] + held[M, E])
+        prior = probabilities[hold].astype(np.float64)
+        moving = (prior[:, M] > prior[:, O]) & (prior[:, M] >= prior[:, E])
+        prior[moving, M] += prior[moving, O]
+        prior[moving, O] = 0.0
+        q[hold] = prior @ held
+    q *= likelihood
     q /= q.sum(axis=1, keepdims=True)
     q[q < FLUSH] = 0.0
     visibility = np.where(seen, VISIBLE, np.where(covered, HIDDEN, UNOBSERVED))
@@ -206,6 +220,59 @@ def test_update_kernel_matches_numpy_over_frames(rng):
         expected = reference_update(grid, {"cam0": depth}, expected.astype(np.float32))[0]
         grid.update({"cam0": depth})
     np.testing.assert_allclose(grid.probabilities.reshape(-1, 3), expected, atol=1e-6, rtol=0)
+
+
+def test_update_kernel_with_hold_matches_numpy(rng):
+    grid, depths = random_setup(rng, num_cameras=2)
+    grid = OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, p_free=0.08, psi=0.05)  # a psi that shows
+    grid._probabilities[...] = rng.dirichlet((0.5, 0.5, 0.5), grid.spec.shape).astype(np.float32)
+    expected = grid.probabilities.reshape(-1, 3).astype(np.float64)
+    holds = [rng.random(grid.spec.shape) < 0.5 for _ in range(3)]
+    unheld = reference_update(grid, depths, expected.astype(np.float32))[0]
+    for hold in holds:
+        expected = reference_update(grid, depths, expected.astype(np.float32), hold.reshape(-1))[0]
+        grid.update(depths, hold=hold)
+        if hold is holds[0]:  # the reference's hold changes the held cells only
+            differs = np.abs(expected - unheld).max(axis=1) > 1e-3
+            assert differs.sum() > 100 and not differs[~hold.reshape(-1)].any()
+    np.testing.assert_allclose(grid.probabilities.reshape(-1, 3), expected, atol=1e-6, rtol=0)
+    np.testing.assert_allclose(grid.held_transition.sum(axis=1), 1.0)
+    assert grid.held_transition[M, O] == 0.0 and grid.held_transition[O, O] == grid.transition[O, O]
+    with pytest.raises(ValueError, match="hold must be a bool array"):
+        grid.update(depths, hold=np.zeros(grid.spec.shape, np.uint8))
+    with pytest.raises(ValueError, match="hold must be a bool array"):
+        grid.update(depths, hold=np.zeros(grid.spec.num_cells, bool))
+
+
+def reference_near_capsules(spec, a, b, radii, margin):
+    """cells_near_capsules in NumPy: every cell centre against every capsule."""
+    centres = spec.centers().reshape(-1, 1, 3)
+    axis = b - a
+    t = np.clip(np.sum((centres - a) * axis, axis=2) / np.maximum(np.sum(axis**2, axis=1), 1e-300), 0.0, 1.0)
+    distance = np.linalg.norm(centres - (a + t[..., None] * axis), axis=2)
+    limit = (1 - t) * radii[:, 0] + t * radii[:, 1] + margin
+    return np.any(distance <= limit, axis=1).reshape(spec.shape)
+
+
+def test_cells_near_capsules_matches_numpy(rng):
+    spec = GridSpec((-1.0, -0.5, -0.025), 0.05, (40, 30, 44))
+    a = rng.uniform((-1.3, -0.8, -0.2), (1.3, 1.3, 2.3), (12, 3))  # some ends outside the grid
+    b = a + rng.normal(0, 0.3, (12, 3))
+    b[0] = a[0]  # a sphere
+    radii = rng.uniform(0.02, 0.15, (12, 2))
+    for margin in (0.0, 0.1):
+        got = cells_near_capsules(spec, a, b, radii, margin)
+        np.testing.assert_array_equal(got, reference_near_capsules(spec, a, b, radii, margin))
+        assert 200 < got.sum() < 0.5 * spec.num_cells
+    assert not cells_near_capsules(spec, np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 2))).any()
+    far = np.array([[10.0, 10.0, 10.0]])
+    assert not cells_near_capsules(spec, far, far, np.full((1, 2), 0.1)).any()
+    with pytest.raises(ValueError, match=r"radii \(C, 2\)"):
+        cells_near_capsules(spec, a, b, radii[:, :1])
+    with pytest.raises(ValueError, match="finite"):
+        cells_near_capsules(spec, np.full((1, 3), np.nan), far, np.full((1, 2), 0.1))
+    with pytest.raises(ValueError, match="margin"):
+        cells_near_capsules(spec, a, b, radii, margin=-0.1)
 
 
 def test_cells_from_depth_matches_numpy(rng):
@@ -389,3 +456,57 @@ def test_a_second_camera_sees_what_the_first_cannot():
     both.update(frame.depth)
     assert np.all(front_only.visibility_at(behind_panel) == HIDDEN)
     assert np.all(both.visibility_at(behind_panel) == VISIBLE)  # hidden only if hidden from every camera
+
+
+def test_capsules_from_primitives_cover_the_rendered_body(rng):
+    scenario = build_scenario("no_occlusion", use_mocap=False)
+    cam = scenario.cameras[0]
+    body = primitives_from_joints(scenario.people[0].joints[120], random_body_shape(rng), 1)
+    a, b, radii = capsules_from_primitives(body)
+    assert a.shape == b.shape == (16, 3) and radii.shape == (16, 2)
+    points, _ = points_from_depth(render_camera(body, cam).depth, cam)
+    assert len(points) > 5000
+    axis = b - a
+    t = np.clip(np.sum((points[:, None] - a) * axis, axis=2) / np.sum(axis**2, axis=1), 0.0, 1.0)
+    distance = np.linalg.norm(points[:, None] - (a + t[..., None] * axis), axis=2)
+    excess = np.min(distance - ((1 - t) * radii[:, 0] + t * radii[:, 1]), axis=1)
+    assert excess.max() < 1e-4  # every surface point lies in some capsule (float32 depth)
+    # and not much bigger: half the surface is on a capsule, 95 % within 7 cm (the chest's
+    # capsule is round, the chest flatter)
+    assert np.median(excess) > -0.005 and np.percentile(excess, 5) > -0.07
+    with pytest.raises(ValueError, match="Primitives"):
+        capsules_from_primitives(a)
+
+
+def test_hold_keeps_a_person_standing_still_moving():
+    # a box-shaped person walks 0.6 m in 24 frames, then stands still for 150 frames: without
+    # the hold the grid takes them for background after frames_until_static (77) frames;
+    # holding the cells near their body (as the tracker does) keeps them moving
+    camera = Camera("cam", 160, 120, 120.0, 120.0, 79.5, 59.5, world_from_camera=look_at((0, 0, 1.2), (0, 3, 1.0)))
+    spec = GridSpec((-2.0, 0.5, -0.025), 0.05, (80, 70, 44))
+    room = concat([box((0, 3.5, 1.1), (3.0, 0.05, 1.1), (128, 128, 128)),   # wall
+                   box((0, 2.0, -0.05), (3.0, 2.0, 0.05), (128, 128, 128))])  # floor
+    room = render_camera(room, camera)
+    grids = {"held": OccupancyGrid(spec, camera), "free": OccupancyGrid(spec, camera)}
+    rng = np.random.default_rng(7)
+    walk, still = 24, 150
+    share = {name: [] for name in grids}
+    for t in range(walk + still):
+        person = box((-0.3 + 0.025 * min(t, walk), 2.22, 0.85), (0.15, 0.1, 0.85), (90, 90, 90), person=1)
+        rendered = render_camera(person, camera, background=room)
+        depth = apply_noise(rendered.depth, "structured_light", rng, fx=camera.fx)
+        hold = cells_near_capsules(spec, *capsules_from_primitives(person), margin=0.1)
+        for name, grid in grids.items():
+            grid.update({"cam": depth}, hold=hold if name == "held" else None)
+            truth = rendered.person > 0
+            share[name].append(foreground_from_grid(grid.states, spec, depth, camera)[truth].mean())
+    held, free = np.array(share["held"]), np.array(share["free"])
+    assert held[walk:].min() > 0.95 and free[walk:walk + 50].min() > 0.95  # both moving at first
+    assert held[-1] > 0.95 and free[-1] < 0.05
+    # without the hold the cells entered last turn static frames_until_static (77) frames after
+    assert np.flatnonzero(free < 0.05)[-1] == len(free) - 1
+    assert np.flatnonzero(free[walk:] < 0.05)[0] == math.ceil(frames_until_static())
+    # the hold takes nothing from the background: the floor cells it covers are as without it
+    floor = hold[:, :, 0]
+    assert floor.sum() > 20 and np.count_nonzero(grids["free"].states[:, :, 0][floor] == O) > 20
+    np.testing.assert_array_equal(grids["held"].states[:, :, 0], grids["free"].states[:, :, 0])

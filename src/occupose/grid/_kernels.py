@@ -15,7 +15,13 @@ Conventions shared with the wrapper:
   ``sizes[c] = (width, height)``; its depth image (metres, float32, row-major) starts at
   ``offsets[c]`` in ``depth``; ``sigma_lut[c, m]`` is its depth noise (one standard deviation,
   metres) at depth ``m * lut_step``; ``half_extents[c]`` is half a cell's extent along its
-  optical axis (metres).
+  optical axis (metres);
+- ``hold`` is an (N,) bool array over the flat cells, or an empty array for none: a held
+  cell takes its forward step with ``held`` instead of ``transition``, and when its MAP
+  state before the step is M, its O share first moves to M (the tracker's hold on the
+  cells of the people it follows, see ``OccupancyGrid.update``). A per-cell mask
+  costs one byte load per cell in the parallel loop; a list of indices would need a
+  scatter into such a mask first.
 """
 
 from __future__ import annotations
@@ -50,8 +56,8 @@ def observation(epsilon, half_extent, width, p_occ, p_free):
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
 def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, offsets, depth,
-                sigma_lut, lut_step, half_extents, tail_width, p_occ, p_free, transition, flush,
-                probabilities, states, visibility):
+                sigma_lut, lut_step, half_extents, tail_width, p_occ, p_free, transition, held, hold,
+                flush, probabilities, states, visibility):
     """One frame of the grid, in place.
 
     origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
@@ -60,10 +66,12 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
     sigma_lut (C, L) float64 metres; lut_step float metres; half_extents (C,) float64 metres
     tail_width, p_occ, p_free : floats of the observation function (tail width in noise stds)
     transition : (3, 3) float64, row = previous state, column = next state
+    held : (3, 3) float64, the transition matrix of held cells; hold : (N,) bool or (0,) bool
     flush : float, posterior probabilities below it are set to 0 (no subnormal floats)
     probabilities : (N, 3) float32 in/out; states, visibility : (N,) uint8 out
     """
     num_cameras = rotations.shape[0]
+    use_hold = hold.size > 0
     lut_last = sigma_lut.shape[1] - 1
     lut_scale = 1.0 / lut_step
     for i in numba.prange(nx):
@@ -108,9 +116,15 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                 q_o = probabilities[n, 0]
                 q_m = probabilities[n, 1]
                 q_e = probabilities[n, 2]
-                r_o = (q_o * transition[0, 0] + q_m * transition[1, 0] + q_e * transition[2, 0]) * b_occupied
-                r_m = (q_o * transition[0, 1] + q_m * transition[1, 1] + q_e * transition[2, 1]) * b_occupied
-                r_e = (q_o * transition[0, 2] + q_m * transition[1, 2] + q_e * transition[2, 2]) * b_empty
+                a = transition
+                if use_hold and hold[n]:
+                    a = held
+                    if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
+                        q_m += q_o
+                        q_o = 0.0
+                r_o = (q_o * a[0, 0] + q_m * a[1, 0] + q_e * a[2, 0]) * b_occupied
+                r_m = (q_o * a[0, 1] + q_m * a[1, 1] + q_e * a[2, 1]) * b_occupied
+                r_e = (q_o * a[0, 2] + q_m * a[1, 2] + q_e * a[2, 2]) * b_empty
                 scale = 1.0 / (r_o + r_m + r_e)
                 r_o *= scale
                 r_m *= scale
@@ -189,3 +203,40 @@ def cells_from_pixels(depth, fx, fy, cx, cy, rotation, translation, origin, cell
                                 best = dist
                                 n = m
             out[p] = n
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def mark_capsules(origin, cell, nx, ny, nz, a, b, radii, margin, out):
+    """Mark the cells whose centre lies within a capsule's radius plus ``margin``, in place.
+
+    origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
+    a, b : (C, 3) float64 world metres, the capsules' ends; radii : (C, 2) float64 metres at
+    a and at b; margin : float metres
+    out : (nx, ny, nz) bool, set True (never cleared) where the distance from the cell centre
+    to the segment ab, at the segment point nearest it (parameter t in [0, 1]), is at most
+    ``(1 - t) radii[c, 0] + t radii[c, 1] + margin``. Only the box of cells around each
+    capsule is visited.
+    """
+    for c in range(a.shape[0]):
+        reach = max(radii[c, 0], radii[c, 1]) + margin
+        low = np.empty(3, np.int64)
+        high = np.empty(3, np.int64)
+        counts = (nx, ny, nz)
+        for r in range(3):
+            low[r] = max(int(math.floor((min(a[c, r], b[c, r]) - reach - origin[r]) / cell)), 0)
+            high[r] = min(int(math.floor((max(a[c, r], b[c, r]) + reach - origin[r]) / cell)), counts[r] - 1)
+        ax, ay, az = a[c, 0], a[c, 1], a[c, 2]
+        dx, dy, dz = b[c, 0] - ax, b[c, 1] - ay, b[c, 2] - az
+        length2 = dx * dx + dy * dy + dz * dz
+        inverse = 1.0 / length2 if length2 > 0.0 else 0.0
+        for i in range(low[0], high[0] + 1):
+            px = origin[0] + cell * (i + 0.5) - ax
+            for j in range(low[1], high[1] + 1):
+                py = origin[1] + cell * (j + 0.5) - ay
+                for k in range(low[2], high[2] + 1):
+                    pz = origin[2] + cell * (k + 0.5) - az
+                    t = min(max((px * dx + py * dy + pz * dz) * inverse, 0.0), 1.0)
+                    ex, ey, ez = px - t * dx, py - t * dy, pz - t * dz
+                    limit = (1.0 - t) * radii[c, 0] + t * radii[c, 1] + margin
+                    if ex * ex + ey * ey + ez * ez <= limit * limit:
+                        out[i, j, k] = True

@@ -68,7 +68,8 @@ For the defaults (alpha 0.01, beta 0.1, gamma 0.4, psi e^-38, p_occ 0.9): ``e = 
 at 30 fps; one more frame passes while the cell enters (E -> M), so a cell first seen
 occupied at frame ``t0`` is O from frame ``t0 + 77`` (a single-cell filter run gives exactly
 that). Without the E share (``e = 0``) the figure would be 74.0. The same holds for a
-person who stands perfectly still: after ``T`` frames they are background.
+person who stands perfectly still: after ``T`` frames they are background, unless the
+tracker holds their cells (``hold`` of :meth:`OccupancyGrid.update`).
 
 Initial distribution (``initial``, default ``(0.4, 0, 0.6)`` for O, M, E). One frame
 cannot tell a static object from a moving one, and the ratio argument above shows that the
@@ -118,6 +119,7 @@ DEFAULT_MAX_RANGE = 4.5
 #: Posterior probabilities below this are set to 0 (float32 never goes subnormal).
 FLUSH = 1e-30
 _LUT_STEP = 0.01
+_NO_HOLD = np.zeros(0, np.bool_)
 _LUT_DEPTH = 12.0
 
 
@@ -158,6 +160,18 @@ def transition_matrix(alpha: float = ALPHA, beta: float = BETA, gamma: float = G
     return np.array([[1.0 - alpha, 0.0, alpha],
                      [psi, 1.0 - gamma - psi, gamma],
                      [0.0, beta, 1.0 - beta]])
+
+
+def held_transition(transition: np.ndarray) -> np.ndarray:
+    """(3, 3) float64: ``transition`` (A[previous, next] over O, M, E) without the M -> O
+    transition, its M row renormalised (``A[M, M]`` and ``A[M, E]`` divided by ``1 - psi``):
+    what cells held by the tracker use (:meth:`OccupancyGrid.update`)."""
+    held = np.array(transition, np.float64)
+    if held.shape != (3, 3) or not 0.0 <= held[M, O] < 1.0:
+        raise ValueError(f"transition must be a (3, 3) matrix with A[M, O] = psi < 1, got {held.tolist()}")
+    held[M] /= 1.0 - held[M, O]
+    held[M, O] = 0.0
+    return held
 
 
 def frames_until_static(alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
@@ -410,6 +424,8 @@ class OccupancyGrid:
         self.spec = spec
         self.cameras = _check_cameras(cameras)
         self.transition = transition_matrix(alpha, beta, gamma, psi)
+        #: (3, 3) the transition matrix of held cells (:meth:`update`): psi = 0, the M row renormalised.
+        self.held_transition = held_transition(self.transition)
         self.alpha, self.beta, self.gamma, self.psi = float(alpha), float(beta), float(gamma), float(psi)
         if not (0.5 < p_occ <= 1.0 and 0.0 <= p_free < 0.5):
             raise ValueError(f"need 0.5 < p_occ <= 1 and 0 <= p_free < 0.5, got p_occ={p_occ!r}, p_free={p_free!r}")
@@ -498,19 +514,43 @@ class OccupancyGrid:
             start = self._offsets[c]
             self._depth[start:start + image.size] = image.reshape(-1)
 
-    def update(self, depths: Mapping[str, np.ndarray]) -> None:
+    def update(self, depths: Mapping[str, np.ndarray], hold: np.ndarray | None = None) -> None:
         """Take one frame: depths is a dict camera name -> (H, W) float32 metres (0 = no measurement).
+
+        hold : None, or (nx, ny, nz) bool: cells the tracker holds as moving in this frame
+            (see :func:`occupose.grid.hold.cells_near_capsules`), so that a person it follows
+            stays M while standing or sitting still. In a held cell the M -> O transition is
+            disabled (``psi = 0``: the M row renormalised, :attr:`held_transition`), and a
+            held cell whose MAP state is M first moves its O share to M. Both are needed:
+            O and M look alike, so a cell's O share grows by the factor ``a`` (1.63 by
+            default, module docstring) every frame it is seen occupied whatever psi is, and
+            even the tiny share left from the initial distribution or from a few unheld
+            frames (about 1e-26 in a cell seen through for 20 frames before a person stepped
+            in) makes it O: with psi = 0 alone, a box walking in from the first frame and
+            held all along turned static 120 frames after it stopped instead of 77
+            (the construction of tests/test_grid.py). Moving the share keeps it at 0. Held cells in O or E step as with psi = 0 only, so the hold takes nothing from
+            the background (the floor under the feet, the seat of a chair stay O) and makes
+            no cell occupied. A bool mask is what the kernel reads cheapest: one byte per
+            cell in its parallel loop.
 
         Runs one fused numba kernel over all cells (it releases the GIL, so another thread
         can work meanwhile).
         """
         self._check_depths(depths)
+        if hold is None:
+            hold = _NO_HOLD
+        else:
+            hold = np.asarray(hold)
+            if hold.shape != self.spec.shape or hold.dtype != np.bool_:
+                raise ValueError(f"hold must be a bool array of the grid's shape {self.spec.shape}, "
+                                 f"got {hold.dtype} {hold.shape}")
+            hold = np.ascontiguousarray(hold).reshape(-1)
         nx, ny, nz = self.spec.shape
         _kernels.update_grid(
             np.asarray(self.spec.origin), self.spec.cell, nx, ny, nz, self._rotations, self._translations,
             self._intrinsics, self._sizes, self._offsets, self._depth, self._sigma_lut, _LUT_STEP,
-            self._half_extents, self.tail_width, self.p_occ, self.p_free, self.transition, FLUSH,
-            self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
+            self._half_extents, self.tail_width, self.p_occ, self.p_free, self.transition, self.held_transition,
+            hold, FLUSH, self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
         )
         self.num_updates += 1
 
