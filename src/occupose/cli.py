@@ -258,3 +258,36 @@ def demo_cmd(out, scenario, frames, method) -> None:
         index = int(present[(2 * len(present)) // 3])
         picture = show_frame(rec, index, out / f"{scenario}_frame{index:04d}.png", tracks)
         click.echo(f"picture: {picture}")
+
+
+@main.command("evaluate")
+@click.option("--scenarios", default=None, help="Scenarios, comma-separated (default: the whole catalogue; see `occupose scenarios`).")
+@click.option("--methods", default="ours,apf,ps", show_default=True, help="Methods, comma-separated (ours, apf, ps, part-based).")
+@click.option("--runs", type=click.IntRange(min=1), default=3, show_default=True, help="Runs per method and scenario (seeds 0..runs-1).")
+@click.option("--frames", type=click.IntRange(min=1), default=None, help="At most N frames of each scenario.")
+@click.option("--procedural", is_flag=True, help="Use the built-in procedural motion even when real mocap clips are present.")
+@click.option("--jobs", type=click.IntRange(min=1), default=None, help="Worker processes (default: one per core; 1: no workers).")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="Folder for recordings/, runs/, results.csv, report.md and the plots (recordings are reused).")
+def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
+    """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
+    from occupose.evaluate import evaluate, table_rows
+    from occupose.metrics import markdown_table
+
+    bars = []  # opened at the first report, once evaluate has checked its input and knows the total
+
+    def progress(n: int, total: int) -> None:
+        if not bars:
+            bars.append(_progress_bar(total, "evaluating"))
+        bars[0].update(n)
+
+    try:
+        result = evaluate(scenarios, methods, runs, out=out, frames=frames, procedural=procedural,
+                          jobs=jobs, progress=progress)
+    except (ValueError, FileNotFoundError) as error:
+        _fail(str(error))
+    finally:
+        for bar in bars:
+            bar.close()
+    click.echo(markdown_table(table_rows(result.runs)))
+    click.echo(f"report: {result.report}\nresults: {result.results}\nplots: {len(result.plots)} in {out}")
