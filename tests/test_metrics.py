@@ -441,3 +441,19 @@ def test_frames_before_anything_of_the_person_is_visible_are_not_scored():
     person = score(gt, visible, {1: track}, fps=30.0).persons[0]
     assert person.all_joints.frames == 60 and person.all_joints.coverage == pytest.approx(95.0)
     assert not person.all_joints.fail and person.all_joints.mean_cm == 0.0
+
+
+def test_frames_missed_while_the_tracker_finds_a_person_do_not_fail():
+    fps = 30.0
+    errors = np.full(300, 0.08)
+    missed = np.zeros(300, bool)
+    errors[:12], missed[:12] = np.nan, True  # found 0.4 s after the first counted frame
+    assert not is_fail(errors, fps, missed=missed)
+    late = errors.copy(), missed.copy()
+    late[0][150:], late[1][150:] = np.nan, True  # lost for good later: FAIL
+    assert is_fail(late[0], fps, missed=late[1])
+    never = np.full(300, np.nan)  # never found: FAIL
+    assert is_fail(never, fps, missed=np.ones(300, bool))
+    slow = errors.copy(), missed.copy()
+    slow[0][:45], slow[1][:45] = np.nan, True  # found only 1.5 s in: the misses after 1 s count
+    assert is_fail(slow[0], fps, missed=slow[1])

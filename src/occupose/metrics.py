@@ -31,7 +31,11 @@ FAIL
     (strictly) at some frame at least ``after_s`` seconds after the person's first
     counted frame: a grace period for the tracker to start. Excluded frames are skipped
     inside a window; a missed frame counts as an error of ``MISSED_ERROR_M`` (1 m), so
-    a person lost for good FAILs while a single dropped frame does not.
+    a person lost for good FAILs while a single dropped frame does not, except inside
+    the grace period, where missed frames are skipped too: a person entering the view is
+    counted from the first frame one joint shows (a hand at the image border), and
+    without this the frames the tracker takes to find them would weigh 1 m each in the
+    few-frame windows right after the grace period. A person never found still FAILs.
 """
 
 from __future__ import annotations
@@ -273,7 +277,8 @@ def fail_curve(
         Frames where ground truth has the person and the tracker has no estimate
         (their ``frame_errors`` must be NaN); they count as ``MISSED_ERROR_M``.
     window_s, after_s : float
-        Window duration and grace period after the first counted frame, seconds.
+        Window duration and grace period after the first counted frame, seconds
+        (missed frames inside it are skipped).
 
     Returns
     -------
@@ -284,8 +289,9 @@ def fail_curve(
     fps = _positive_float(fps, "fps")
     after_s = _nonnegative_float(after_s, "after_s")
     counted = np.flatnonzero(~np.isnan(values))
-    curve = rolling_mean(np.where(np.isinf(values), MISSED_ERROR_M, values), fps, window_s=window_s)
     start = counted[0] + int(math.ceil(after_s * fps - 1e-9)) if counted.size else values.size
+    values[:start][np.isinf(values[:start])] = np.nan  # the tracker's time to find the person
+    curve = rolling_mean(np.where(np.isinf(values), MISSED_ERROR_M, values), fps, window_s=window_s)
     curve[:start] = np.nan
     return curve
 

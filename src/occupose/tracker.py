@@ -44,6 +44,7 @@ from occupose.body import (
 )
 from occupose.camera import Camera, pixels_from_points
 from occupose.grid.blobs import blobs_from_mask
+from occupose.grid.hold import cells_near_capsules
 from occupose.grid.observation import observations_from_depth, predicted_from_tracks
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.tracking import BlobTracker
@@ -82,12 +83,14 @@ class Method:
 
 #: The methods of the papers with their budgets. ``ours`` is the first paper's filter
 #: (annealed layers within partitions, 200 particles; its "5 layers" read as 5 layers
-#: spread over the 3 partitioned-sampling stages, 3 on the root and 1 each on the arms
-#: and the legs: 1000 likelihood evaluations per frame) with occlusion handling; ``apf``
+#: spread over the 3 partitioned-sampling stages, 2 on the root, 1 on the head and arms,
+#: 2 on the legs: 1000 likelihood evaluations per frame; on sit_behind_table, 300 frames,
+#: this split gave 8.3 cm against 11.0 cm for 3, 1, 1 and 19.2 cm for 1, 1, 3) with
+#: occlusion handling; ``apf``
 #: and ``ps`` its baselines (2000 evaluations each, no occlusion handling); ``part-based``
 #: the second paper's upper-body filter. All use the same likelihood.
 METHODS: dict[str, Method] = {
-    "ours": Method("apf+ps", 200, (3, 1, 1), occlusion=True),
+    "ours": Method("apf+ps", 200, (2, 1, 2), occlusion=True),
     "apf": Method("apf", 200, 10),
     "ps": Method("ps", 2000),
     "part-based": Method("part-based", 400, model="upper"),
@@ -350,10 +353,14 @@ class Tracker:
     cell : grid cell edge, metres; grid_options : passed to OccupancyGrid
     max_gap_s : seconds a track survives without its blob (a person walking behind a tall
         cabinet is gone for 1-2 s; while gone the pose moves with the blob track's velocity)
+    hold_people : hold the grid cells of the people estimated in the last frame (no moving
+        -> static transition there, :func:`occupose.grid.hold.cells_near_capsules`), so a
+        person standing or sitting still is not absorbed into the background
     """
 
     def __init__(self, cameras, fps: float, method: str = "ours", *, seed: int = 0, cell: float = 0.05,
-                 grid_options: Mapping | None = None, max_gap_s: float = MAX_GAP_S, **overrides):
+                 grid_options: Mapping | None = None, max_gap_s: float = MAX_GAP_S, hold_people: bool = True,
+                 **overrides):
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; valid names: {', '.join(METHODS)}")
         unknown = set(overrides) - set(Method.__dataclass_fields__)
@@ -371,6 +378,7 @@ class Tracker:
         self.grid = OccupancyGrid(self.spec, cameras, **dict(grid_options or {}))
         self.blobs = BlobTracker(self.fps, max_gap_s)
         self.people: dict[int, _Person] = {}
+        self.hold_people = bool(hold_people)
         self._seeds = np.random.SeedSequence(seed)
         self._previous = {}
         self._pending: dict[int, list[np.ndarray]] = {}  # points of tracks not yet started
@@ -386,7 +394,7 @@ class Tracker:
         """
         self.frame += 1
         clock = time.perf_counter()
-        self.grid.update(depths)
+        self.grid.update(depths, hold=self._hold() if self.hold_people else None)
         clock = self._tick("grid", clock)
         labels, blobs = blobs_from_mask(self.grid.moving_mask(), self.spec)
         seen = self.blobs.update(blobs)
@@ -418,6 +426,16 @@ class Tracker:
                 out[tid] = person.estimate(False)
         self._tick("pose", clock)
         return dict(sorted(out.items()))
+
+    def _hold(self) -> np.ndarray | None:
+        """(nx, ny, nz) bool, the cells within the grid's hold margin of the bodies of the
+        people estimated in the last frame, or None when there are none."""
+        bodies = [capsules_from_poses(p.model, p.pose[None]) + (p.model.capsule_radii,)
+                  for p in self.people.values() if not p.lost]
+        if not bodies:
+            return None
+        a, b, radii = (np.concatenate([body[i][0] if i < 2 else body[i] for body in bodies]) for i in range(3))
+        return cells_near_capsules(self.spec, a, b, radii)
 
     def _tick(self, stage: str, start: float) -> float:
         now = time.perf_counter()
