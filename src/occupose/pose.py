@@ -24,11 +24,15 @@ class PoseProblem:
     stages : the partitioned-sampling order as groups of the model's partitions (indices
         into ``model.partitions``), each group sampled as one partition; default: the root,
         then head and arms, then legs (the model's own partitions when it has no legs)
+    part_weights : how the part-based filter weights each of ``model.weight_groups``, a
+        key of :data:`PART_WEIGHTS` (see :func:`chain_weight_groups`)
     """
 
     def __init__(self, model: BodyModel, likelihood: str = "points+free", *, fps: float = 30.0,
                  diffusion: np.ndarray | None = None, likelihood_options: dict | None = None,
-                 stages: list[list[int]] | None = None):
+                 stages: list[list[int]] | None = None, part_weights: str = "chain"):
+        if part_weights not in PART_WEIGHTS:
+            raise ValueError(f"unknown part_weights {part_weights!r}; valid names: {', '.join(PART_WEIGHTS)}")
         self.model = model
         self.likelihood_name = likelihood
         self.likelihood_options = dict(likelihood_options or {})
@@ -44,7 +48,7 @@ class PoseProblem:
         stages = default_stages(model) if stages is None else stages
         self.partitions = [type(model.partitions[0])(np.concatenate([model.partitions[i].dofs for i in group]),
                                                      everything) for group in stages]
-        self.weight_groups = model.weight_groups
+        self.weight_groups = PART_WEIGHTS[part_weights](model)
         self.hidden_parts = np.zeros(len(model.part_names), bool)
         self._likelihood = None
 
@@ -61,6 +65,52 @@ class PoseProblem:
                                         len(self.model.part_names))
         out[:, self.hidden_parts] = 0.0
         return out
+
+
+def _moved_parts(model: BodyModel, dofs: np.ndarray) -> np.ndarray:
+    """(K,) bool, the parts with a capsule end on a node that one of ``dofs`` moves (the
+    DOFs' nodes and their descendants)."""
+    moved = np.zeros(len(model.node_names), bool)
+    moved[model.dof_node[dofs]] = True
+    for j in range(len(moved)):  # parent-first order: a node moves with its parent
+        if model.parents[j] >= 0 and moved[model.parents[j]]:
+            moved[j] = True
+    capsules = moved[model.capsule_nodes[0]] | moved[model.capsule_nodes[1]]
+    return np.bincount(model.capsule_part[capsules], minlength=len(model.part_names)) > 0
+
+
+def own_weight_groups(model: BodyModel) -> list:
+    """The model's weight groups as they are: each group weighted by its own parts (the
+    second paper's Table 1). With points given to their nearest part this rewards a part
+    for leaving its points to another part: the root group of the upper model, weighted
+    by the shoulders alone, drifts away from the person."""
+    return list(model.weight_groups)
+
+
+def chain_weight_groups(model: BodyModel) -> list:
+    """The model's weight groups, each weighted by the parts its DOFs move and the own
+    parts of every group that moves it (its chain to the root).
+
+    A limb's points that it leaves go to the trunk, whose columns are then in its weight,
+    so leaving costs; sibling limbs stay out of each other's weights, which is what the
+    part-based filter's separate resampling and shuffling need. A group that moves the
+    whole body (the root) is weighted by every part.
+    """
+    groups = list(model.weight_groups)
+    moves = [_moved_parts(model, g.dofs) for g in groups]
+    out = []
+    for g, group in enumerate(groups):
+        parts = moves[g].copy()
+        parts[group.parts] = True
+        for h, other in enumerate(groups):
+            if h != g and moves[h][group.parts].all():  # h moves all of g's parts: an ancestor
+                parts[other.parts] = True
+        out.append(type(group)(group.dofs, np.flatnonzero(parts)))
+    return out
+
+
+#: How the part-based filter weights the model's weight groups, by name.
+PART_WEIGHTS = {"chain": chain_weight_groups, "own": own_weight_groups}
 
 
 def default_stages(model: BodyModel) -> list[list[int]]:

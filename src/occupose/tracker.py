@@ -61,9 +61,12 @@ class Method:
 
     filter : name in occupose.filters.FILTERS; particles : particles per person
     layers : annealing layers (an int, or one per partitioned-sampling stage; None for
-        filters without layers)
+        filters without layers); a model with another number of stages gets the same total
+        spread from the root down (the upper model: (2, 1, 2) -> (3, 2))
     likelihood : name in occupose.likelihood.LIKELIHOODS
-    occlusion : whether hidden parts are detected and left out (occupose.occlusion)
+    occlusion : whether hidden parts are detected and left out (occupose.occlusion; the
+        full model only: the upper model is for ceiling cameras, where furniture hides
+        no part of the upper body)
     model : "full", "upper" or "auto" (``upper`` for a camera looking steeply down)
     max_points : most observed points per person and frame given to the likelihood
     """
@@ -93,7 +96,7 @@ METHODS: dict[str, Method] = {
     "ours": Method("apf+ps", 200, (2, 1, 2), occlusion=True),
     "apf": Method("apf", 200, 10),
     "ps": Method("ps", 2000),
-    "part-based": Method("part-based", 400, model="upper"),
+    "part-based": Method("part-based", 1000, model="upper"),
 }
 
 #: A camera whose optical axis points down more steeply than this (radians below the
@@ -272,10 +275,16 @@ class _Person:
         self.model = model
         self.method = method
         self.problem = PoseProblem(model, method.likelihood, fps=fps)
-        self.estimator = PoseEstimator(self.problem, method.filter, method.particles, rng, **method.filter_options)
+        options = method.filter_options
+        layers = options.get("num_layers")
+        stages = len(self.problem.partitions)
+        if isinstance(layers, tuple) and len(layers) != stages:  # e.g. the upper model: 2 stages
+            total = sum(layers)  # the same number of layers, spread from the root down
+            options["num_layers"] = tuple(total // stages + (k < total % stages) for k in range(stages))
+        self.estimator = PoseEstimator(self.problem, method.filter, method.particles, rng, **options)
         self.occlusion = None
-        if method.occlusion:
-            parents, dofs = _part_tree(model)
+        if method.occlusion and model.name == "full":  # the upper body is for ceiling cameras,
+            parents, dofs = _part_tree(model)  # under which furniture hides no part of it
             self.occlusion = OcclusionState(parents, dofs, model.num_dofs)
         self.joint_parts = _joint_parts(model)
         self.pose: np.ndarray | None = None
