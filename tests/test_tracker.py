@@ -194,6 +194,7 @@ def test_track_command_writes_tracks_and_summary(tmp_path, walk):
     assert "1 track(s) in 25 frames" in result.output and "person 1 (track 1) all joints" in result.output
     summary = json.loads((out / "summary.json").read_text())
     assert summary["method"] == "ours" and summary["particles"] == 100 and summary["layers"] == [2, 1, 1]
+    assert summary["model"] == "full"  # what auto chose for a front camera
     assert summary["frames"] == 25 and summary["people"] == 1 and summary["fps"] > 0
     tracks = read_tracks_csv(out / "tracks.csv", 25)
     assert list(tracks) == [1] and np.isfinite(tracks[1][0][-1]).all()

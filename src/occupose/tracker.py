@@ -599,6 +599,7 @@ def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=
     """
     tracker = Tracker(recording.cameras, recording.fps, method, seed=seed, **settings)
     result = track_frames(tracker, recording.frames(), recording.num_frames, progress)
-    result.settings = {"method": method, "model": tracker.model_name, "seed": seed,
-                       **{k: getattr(tracker.method, k) for k in Method.__dataclass_fields__}}
+    result.settings = {"method": method, "seed": seed,
+                       **{k: getattr(tracker.method, k) for k in Method.__dataclass_fields__},
+                       "model": tracker.model_name}
     return result
