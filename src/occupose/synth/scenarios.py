@@ -332,22 +332,28 @@ def _lifted(prims: Primitives, dz: float) -> Primitives:
 
 
 def _two_people_crossing(rng, use_mocap, sensor):
-    a = _Motion(use_mocap, (-2.3, 3.5), 0.0, _dims(rng))
-    _walk(a, 0.0, 3.6)
-    a.procedural(lambda b: b.turn(FACING_CAMERA))
+    # both in view and walking at frame 0 (the recording starts 1 s into the walks, as in
+    # no_occlusion), B passing in front of A at about frame 50; the walks end inside the
+    # front camera's view (it spans |x| < 1.9 m at y = 3.5 and 1.35 m at y = 2.5), so both
+    # stay in full view while they turn to the camera, wave, and then stand still. The
+    # walks are procedural: they must end at exact spots.
+    a = _Motion(use_mocap, (-1.75, 3.5), 0.0, _dims(rng))
+    a.procedural(lambda b: b.walk([(1.15, 3.5)], speed=0.7).turn(FACING_CAMERA))
     a.clip_or("dataset-2_wave-right-hand_active_001", lambda b: b.wave("right", 3.0, 4))
-    b_ = _Motion(use_mocap, (2.3, 2.5), math.pi, _dims(rng))
-    b_.procedural(lambda b: b.stand(0.4))
-    _walk(b_, math.pi, 3.6, clip="dataset-1_walk_active_001")
-    b_.procedural(lambda b: b.turn(FACING_CAMERA))
+    b_ = _Motion(use_mocap, (1.15, 2.5), math.pi, _dims(rng))
+    b_.procedural(lambda b: b.walk([(-0.4, 2.5)], speed=0.6).turn(FACING_CAMERA))
     b_.clip_or("dataset-2_wave-both-hands_active_001", lambda b: b.wave("both", 3.0, 4))
     cams, noise = _front(sensor)
-    people = (Person(a.joints(330), random_body_shape(rng)), Person(b_.joints(330), random_body_shape(rng)))
+    people = (Person(a.joints(330, skip=30), random_body_shape(rng)),
+              Person(b_.joints(330, skip=30), random_body_shape(rng)))
     return dict(cameras=cams, noise=noise, static=_front_room(), people=people, motion_source=_source(a, b_))
 
 
 def _top_arms(rng, use_mocap, sensor, clothing: str, clips: tuple[str, ...]):
-    m = _Motion(use_mocap, (0.25, -0.2), math.pi / 2, _dims(rng))
+    # steps in from the edge of the view, walking at frame 0 (the grid tells a person from
+    # the background by their motion: one who stands still from the first frame is floor)
+    m = _Motion(use_mocap, (0.25, -0.95), math.pi / 2, _dims(rng))
+    m.procedural(lambda b: b.walk([(0.25, -0.2)], speed=0.8))
     procedural = [lambda b: b.wave("right", 3.0, 4), lambda b: b.gesture("point", "left", 2.5),
                   lambda b: b.wave("both", 3.0, 4), lambda b: b.gesture("cross", "both", 2.5),
                   lambda b: b.gesture("side", "right", 2.5), lambda b: b.wave("left", 3.0, 4)]
@@ -355,7 +361,7 @@ def _top_arms(rng, use_mocap, sensor, clothing: str, clips: tuple[str, ...]):
         m.clip_or(clip, actions)
     cams, noise = _top(sensor)
     return dict(cameras=cams, noise=noise, static=_shop_room(),
-                people=(Person(m.joints(450), random_body_shape(rng, clothing)),), motion_source=_source(m))
+                people=(Person(m.joints(450, skip=15), random_body_shape(rng, clothing)),), motion_source=_source(m))
 
 
 def _top_view_arms(rng, use_mocap, sensor):
@@ -373,15 +379,20 @@ def _top_view_arms_flashy(rng, use_mocap, sensor):
 
 
 def _top_view_two_people(rng, use_mocap, sensor):
-    a = _Motion(use_mocap, (-0.42, 0.0), 0.0, _dims(rng))
-    b_ = _Motion(use_mocap, (0.42, 0.05), math.pi, _dims(rng))
+    # both step in towards each other, walking at frame 0 (a person standing still from the
+    # first frame is background to the grid), and stop face to face 0.84 m apart
+    a = _Motion(use_mocap, (-1.1, 0.0), 0.0, _dims(rng))
+    b_ = _Motion(use_mocap, (1.1, 0.05), math.pi, _dims(rng))
     # facing each other, A's right arm and B's left arm are on the same side: they overlap
-    a.procedural(lambda b: b.gesture("reach", "right", 3.0).wave("both", 2.5, 3).gesture("reach", "both", 2.5))
+    a.procedural(lambda b: b.walk([(-0.42, 0.0)], speed=0.8).gesture("reach", "right", 3.0).wave("both", 2.5, 3)
+                 .gesture("reach", "both", 2.5))
     a.clip_or("dataset-2_wave-right-hand_active_001", lambda b: b.wave("right", 3.0, 4))
-    b_.procedural(lambda b: b.gesture("reach", "left", 3.0).gesture("cross", "both", 2.5).gesture("reach", "both", 2.5))
+    b_.procedural(lambda b: b.walk([(0.42, 0.05)], speed=0.8).gesture("reach", "left", 3.0)
+                  .gesture("cross", "both", 2.5).gesture("reach", "both", 2.5))
     b_.clip_or("dataset-2_wave-both-hands_active_001", lambda b: b.wave("both", 3.0, 4))
     cams, noise = _top(sensor)
-    people = (Person(a.joints(300), random_body_shape(rng)), Person(b_.joints(300), random_body_shape(rng)))
+    people = (Person(a.joints(300, skip=15), random_body_shape(rng)),
+              Person(b_.joints(300, skip=15), random_body_shape(rng)))
     return dict(cameras=cams, noise=noise, static=_shop_room(), people=people, motion_source=_source(a, b_))
 
 
@@ -408,16 +419,17 @@ SCENARIOS: dict[str, ScenarioEntry] = {
     "moved_chair": ScenarioEntry(
         "carries a chair to a new place, leaves it and walks away: the background must update", _moved_chair),
     "two_people_crossing": ScenarioEntry(
-        "two people cross the room in opposite directions, one passing in front of the other",
+        "two people cross the room in opposite directions, one passing in front of the other, then wave; "
+        "both in full view throughout",
         _two_people_crossing),
     "top_view_arms": ScenarioEntry(
-        "ceiling camera at 2.9 m, one person in dark clothes moving the arms (second paper's S1)",
+        "ceiling camera at 2.9 m, one person in dark clothes steps in and moves the arms (second paper's S1)",
         _top_view_arms),
     "top_view_arms_flashy": ScenarioEntry(
-        "ceiling camera at 2.9 m, one person in flashy clothes moving the arms (second paper's S2)",
+        "ceiling camera at 2.9 m, one person in flashy clothes steps in and moves the arms (second paper's S2)",
         _top_view_arms_flashy),
     "top_view_two_people": ScenarioEntry(
-        "ceiling camera, two people face to face whose arms reach across and overlap (S3)",
+        "ceiling camera, two people step in face to face, their arms reach across and overlap (S3)",
         _top_view_two_people),
     "two_cameras_occlusion": ScenarioEntry(
         "sit_behind_table seen by a front and a side camera (the side one sees the legs)",
