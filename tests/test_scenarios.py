@@ -221,6 +221,26 @@ def test_two_people_crossing_one_passes_in_front():
     assert min(front) >= 0.6  # the one in front is not hidden by the other
 
 
+def test_two_people_crossing_stay_in_full_view(rendered):
+    scenario, synth = rendered("two_people_crossing")
+    cam = scenario.cameras[0]
+    for frame in synth:
+        person = frame.rendered[cam.name].person
+        edge = np.concatenate([person[0], person[-1], person[:, 0], person[:, -1]])
+        assert frame.present.all() and not edge.any(), frame.index  # nobody cut by the image border
+        assert all(_in_full_view(scenario, frame, p) for p in range(2))
+    a, b = (p.joints[:, JOINT_INDEX["pelvis"]] for p in scenario.people)
+    assert np.linalg.norm(a[1] - a[0]) > 0.01 and np.linalg.norm(b[1] - b[0]) > 0.01  # walking at frame 0
+
+
+def test_top_view_people_walk_in_at_the_first_frame():
+    for name in ("top_view_arms", "top_view_two_people"):
+        for person in build_scenario(name, use_mocap=False).people:
+            pelvis = person.joints[:, JOINT_INDEX["pelvis"], :2]
+            assert np.linalg.norm(pelvis[1] - pelvis[0]) > 0.01  # moving: the grid extracts them
+            assert np.linalg.norm(pelvis[30] - pelvis[0]) > 0.25
+
+
 def test_top_view_scenes_look_down_from_2_9_m(rendered):
     for name, style in (("top_view_arms", "dark"), ("top_view_arms_flashy", "flashy")):
         scenario = build_scenario(name, use_mocap=False)
