@@ -148,6 +148,62 @@ def test_block_pruning_is_exact_on_a_body(front, rng):
     assert np.mean(capsule == want_capsule[:, whole.position]) > 0.999
 
 
+def _blocks_reference(points, block_size):
+    """Index sets of the median splits (lower half first), by NumPy partitioning."""
+    leaves, stack = [], [np.arange(len(points))]
+    while stack:
+        index = stack.pop()
+        if len(index) <= block_size:
+            if len(index):
+                leaves.append(index)
+            continue
+        chosen = points[index]
+        axis = int(np.argmax(np.ptp(chosen, axis=0)))
+        split = np.argsort(chosen[:, axis], kind="stable")
+        half = len(index) // 2
+        stack += [index[split[half:]], index[split[:half]]]
+    return leaves
+
+
+def test_blocked_points_match_reference(rng):
+    from occupose.likelihood._capsules import blocked_points
+
+    points = rng.normal(size=(500, 3)) * [0.3, 0.2, 0.6] + [1.0, 2.0, 1.0]
+    blocks = blocked_points(points, block_size=40, pad=16)
+    leaves = _blocks_reference(points, 40)
+    assert len(blocks.block_start) == len(leaves) + 1
+    entries = np.stack([blocks.px, blocks.py, blocks.pz], axis=1).astype(np.float64) + blocks.origin
+    np.testing.assert_allclose(entries[blocks.position], points, atol=1e-6)
+    np.testing.assert_allclose(blocks.origin, points.mean(axis=0))
+    for b, leaf in enumerate(leaves):
+        lo, hi = blocks.block_start[b], blocks.block_start[b + 1]
+        assert (hi - lo) % 16 == 0 and hi - lo - len(leaf) < 16
+        assert sorted(blocks.position[leaf]) == list(range(lo, lo + len(leaf)))  # the same points, first
+        np.testing.assert_array_equal(blocks.weight[lo:hi], np.arange(hi - lo) < len(leaf))
+        assert np.all(entries[lo + len(leaf):hi] == entries[lo + len(leaf) - 1])  # padding: the last point
+        ball = np.linalg.norm(points[leaf] - blocks.origin - blocks.block_centre[:, b], axis=1)
+        np.testing.assert_allclose(blocks.block_radius[b], ball.max() + 1e-5, atol=1e-9)
+    empty = blocked_points(np.zeros((0, 3)))
+    assert len(empty.px) == 0 and list(empty.block_start) == [0]
+
+
+def test_offset_depths_match_reference(rng):
+    from occupose.likelihood._samples import offset_depths
+    from occupose.synth.noise import depth_std
+
+    depth = rng.uniform(0.4, 7.5, (30, 40)).astype(np.float32)
+    depth[rng.random((30, 40)) < 0.2] = 0.0
+    for noise, margin, sign in (("structured_light", 0.03, -1.0), ("tof", 0.1, 1.0), ("none", 0.0, -1.0)):
+        want = np.where(depth > 0, depth + sign * (margin + 3 * depth_std(depth.astype(np.float64), noise)), 0.0)
+        got = offset_depths(depth, margin, noise, sign)
+        assert got.dtype == np.float32 and got.shape == depth.shape
+        np.testing.assert_allclose(got, want, atol=1e-6)
+    with pytest.raises(ValueError, match="margin"):
+        offset_depths(depth, -0.1, "tof", 1.0)
+    with pytest.raises(ValueError, match="noise"):
+        offset_depths(depth, 0.1, "sonar", 1.0)
+
+
 def test_points_likelihood_matches_reference(rng):
     a, b, radii = _random_capsules(rng)
     part = np.array([0, 2, 1, 2, 0])

@@ -6,6 +6,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from occupose.likelihood import _kernels
+
 
 def check_capsules(a, b, radii, capsule_part, num_parts):
     """Check and convert the particles' capsules.
@@ -48,7 +50,7 @@ def check_positive(value, what: str) -> float:
 
 #: Metres added to the blocks' radii to cover float32 rounding of the point distances.
 BOUND_SLACK = 1e-5
-#: Points per block of the points kernels (see occupose.likelihood._kernels._nearest_capsules).
+#: Points per block of the points kernels (see occupose.likelihood._kernels._nearest_in_block).
 BLOCK_SIZE = 64
 #: Blocks are padded to a multiple of this many points (copies of their last point, weight
 #: 0), so that the vectorised point loop has no scalar remainder (4 x 8 float32 lanes).
@@ -88,35 +90,28 @@ def blocked_points(points: np.ndarray, block_size: int = BLOCK_SIZE, pad: int = 
     """Split (N, 3) float64 points into spatially compact blocks of at most ``block_size``
     points (halving each set at the median of its longest side), each padded to a multiple
     of ``pad`` entries, for the points kernels."""
-    leaves, stack = [], [np.arange(len(points))]
-    while stack:
-        index = stack.pop()
-        if len(index) <= block_size:
-            if len(index):
-                leaves.append(index)
-            continue
-        chosen = points[index]
-        axis = int(np.argmax(np.ptp(chosen, axis=0)))
-        half = len(index) // 2
-        split = np.argpartition(chosen[:, axis], half)
-        stack += [index[split[half:]], index[split[:half]]]
-    origin = points.mean(axis=0) if len(points) else np.zeros(3)
-    sizes = np.array([-(-len(leaf) // pad) * pad for leaf in leaves], np.int64)
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    order = np.empty(len(points), np.int64)
+    leaf_start = _kernels.block_order(points, int(block_size), order)
+    counts = np.diff(leaf_start)
+    sizes = -(-counts // pad) * pad
     start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    padded = np.zeros((start[-1], 3))
-    weight = np.zeros(start[-1], np.float32)
+    # entry j of block b holds point order[leaf_start[b] + min(j, count - 1)]: padding
+    # repeats the block's last point
+    block = np.repeat(np.arange(len(counts)), sizes)
+    slot = np.arange(start[-1]) - start[block]
+    source = order[leaf_start[block] + np.minimum(slot, counts[block] - 1)]
+    origin = points.mean(axis=0) if len(points) else np.zeros(3)
+    padded = points[source] - origin
+    weight = (slot < counts[block]).astype(np.float32)
     position = np.empty(len(points), np.int64)
-    centre = np.zeros((len(leaves), 3))
-    radius = np.zeros(len(leaves))
-    for b, leaf in enumerate(leaves):
-        block = points[leaf] - origin
-        lo, count = start[b], len(leaf)
-        padded[lo:lo + count] = block
-        padded[lo + count:start[b + 1]] = block[-1]
-        weight[lo:lo + count] = 1.0
-        position[leaf] = np.arange(lo, lo + count)
-        centre[b] = 0.5 * (block.min(axis=0) + block.max(axis=0))
-        radius[b] = np.sqrt(np.max(np.sum((block - centre[b]) ** 2, axis=1)))
+    position[source[weight > 0]] = np.flatnonzero(weight)
+    if len(counts):
+        first = start[:-1]
+        centre = 0.5 * (np.minimum.reduceat(padded, first) + np.maximum.reduceat(padded, first))
+        radius = np.sqrt(np.maximum.reduceat(np.sum((padded - centre[block]) ** 2, axis=1), first))
+    else:
+        centre, radius = np.zeros((0, 3)), np.zeros(0)
     px, py, pz = (np.ascontiguousarray(padded[:, i], dtype=np.float32) for i in range(3))
     return PointBlocks(origin, px, py, pz, start, np.ascontiguousarray(centre.T), radius + BOUND_SLACK, weight,
                        position)

@@ -71,80 +71,119 @@ def _capsule_constants(ax, ay, az, bx, by, bz, r1, r2):
     return ax, ay, az, dx / length, dy / length, dz / length, length, rr * abs(rr) / a2, a2 / l2, rr / length, r1, r2
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius, best, arg):
-    """For each point i: ``best[i]`` = min over capsules of |signed distance| (float32,
-    metres) and ``arg[i]`` the capsule that attains it, for particle ``p``.
+@numba.njit(cache=True, nogil=True)
+def block_order(points, block_size, order):
+    """Split (N, 3) float64 points into spatially compact blocks of at most ``block_size``
+    points: halve each set at the median of its longest side (the lower half first) until
+    it is small enough. order : (N,) int64 out, the points block after block.
+    Returns (B + 1,) int64: block b is order[start[b]:start[b + 1]]."""
+    n = points.shape[0]
+    for i in range(n):
+        order[i] = i
+    start = [0]
+    stack = [(0, n)]
+    while len(stack):
+        lo, hi = stack.pop()
+        if hi - lo <= block_size:
+            if hi > lo:
+                start.append(hi)
+            continue
+        axis, widest = 0, -1.0
+        for k in range(3):
+            low, high = np.inf, -np.inf
+            for i in range(lo, hi):
+                low = min(low, points[order[i], k])
+                high = max(high, points[order[i], k])
+            if high - low > widest:
+                axis, widest = k, high - low
+        index = order[lo:hi].copy()
+        ranked = np.argsort(points[index, axis], kind="mergesort")
+        for i in range(hi - lo):
+            order[lo + i] = index[ranked[i]]
+        half = lo + (hi - lo) // 2
+        stack.append((half, hi))
+        stack.append((lo, half))
+    return np.array(start, np.int64)
 
-    The points come in spatially compact blocks (block b holds points block_start[b] to
-    block_start[b + 1] - 1, within block_radius[b] of block_centre[:, b], all minus origin).
-    As the distance is 1-Lipschitz, no point of block b is nearer than |d(centre)| - radius
-    to a capsule, so each block visits the capsules in order of that bound and stops at the
-    first whose bound exceeds the block's worst distance so far: the result is the
-    exhaustive one (up to float32 rounding on near-ties), in a fraction of the time.
-    """
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _particle_bounds(a, b, radii, p, origin, block_centre, block_radius, consts, bounds):
+    """The capsules of particle ``p`` for the block search of :func:`_nearest_in_block`:
+    consts (C, 12) gets their :func:`_capsule_constants` (minus origin) and bounds (C, B)
+    the lower bound |d(block centre)| - block radius of every point of each block's
+    distance to each capsule (the distance is 1-Lipschitz)."""
     num_capsules = a.shape[1]
-    consts = np.empty((num_capsules, 12))
     for c in range(num_capsules):
         values = _capsule_constants(
             a[p, c, 0] - origin[0], a[p, c, 1] - origin[1], a[p, c, 2] - origin[2],
             b[p, c, 0] - origin[0], b[p, c, 1] - origin[1], b[p, c, 2] - origin[2], radii[c, 0], radii[c, 1])
         for j in range(12):
             consts[c, j] = values[j]
-    num_blocks = block_start.shape[0] - 1
-    bounds = np.empty((num_capsules, num_blocks))
     for c in range(num_capsules):  # vectorised over blocks
         ax, ay, az, ex, ey, ez = consts[c, 0], consts[c, 1], consts[c, 2], consts[c, 3], consts[c, 4], consts[c, 5]
         length, k, s, g, r1, r2 = consts[c, 6], consts[c, 7], consts[c, 8], consts[c, 9], consts[c, 10], consts[c, 11]
-        for block in range(num_blocks):
+        for block in range(block_radius.shape[0]):
             bounds[c, block] = abs(_round_cone_distance(block_centre[0, block], block_centre[1, block],
                                                         block_centre[2, block], ax, ay, az, ex, ey, ez, length, k,
                                                         s, g, r1, r2)) - block_radius[block]
-    bound = np.empty(num_capsules)
-    order = np.empty(num_capsules, np.int64)
-    best_bits = best.view(np.int32)
-    scratch = np.empty(1, np.float32)
-    scratch_bits = scratch.view(np.int32)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+def _nearest_in_block(consts, bounds, block, px, py, pz, lo, hi, best, arg, bound, order, best_bits, scratch,
+                      scratch_bits):
+    """For each point i of entries lo..hi - 1 (uint64) of block ``block``: ``best[i]`` = min
+    over capsules of |signed distance| (float32, metres) and ``arg[i]`` the capsule that
+    attains it. Returns n: the capsules visited are order[:n] (every capsule that attains
+    some point's minimum is among them).
+
+    The block visits the capsules in order of their bounds (see :func:`_particle_bounds`)
+    and stops at the first whose bound exceeds the block's worst distance so far: the
+    result is the exhaustive one (up to float32 rounding on near-ties), in a fraction of
+    the time. bound (C,) float64, order (C,) int64: scratch; best_bits, scratch, scratch_bits:
+    int32 view of best, a float32 (1,) array and its int32 view.
+    """
+    num_capsules = consts.shape[0]
+    for c in range(num_capsules):  # insertion sort of the capsules by their bound
+        value = bounds[c, block]
+        j = c
+        while j > 0 and bound[j - 1] > value:
+            bound[j] = bound[j - 1]
+            order[j] = order[j - 1]
+            j -= 1
+        bound[j] = value
+        order[j] = c
+    for i in range(lo, hi):
+        best[i] = np.inf
+        arg[i] = 0
     f = np.float32
+    worst = np.inf
+    visited = 0
     # Unsigned loop bounds and no array views in the loops: a signed start makes numba guard
     # every index against wraparound, and views cost reference counting, both of which
     # keep the point loop from vectorising or dominate it.
-    for block in range(num_blocks):
-        lo, hi = np.uint64(block_start[block]), np.uint64(block_start[block + 1])
-        for c in range(num_capsules):  # insertion sort of the capsules by their bound
-            value = bounds[c, block]
-            j = c
-            while j > 0 and bound[j - 1] > value:
-                bound[j] = bound[j - 1]
-                order[j] = order[j - 1]
-                j -= 1
-            bound[j] = value
-            order[j] = c
+    for j in range(num_capsules):
+        if bound[j] >= worst:
+            break
+        visited += 1
+        c = order[j]
+        ax, ay, az = f(consts[c, 0]), f(consts[c, 1]), f(consts[c, 2])
+        ex, ey, ez = f(consts[c, 3]), f(consts[c, 4]), f(consts[c, 5])
+        length, k, s, g = f(consts[c, 6]), f(consts[c, 7]), f(consts[c, 8]), f(consts[c, 9])
+        r1, r2 = f(consts[c, 10]), f(consts[c, 11])
+        cc = np.int32(c)
         for i in range(lo, hi):
-            best[i] = np.inf
-            arg[i] = 0
-        worst = np.inf
-        for j in range(num_capsules):
-            if bound[j] >= worst:
-                break
-            c = order[j]
-            ax, ay, az = f(consts[c, 0]), f(consts[c, 1]), f(consts[c, 2])
-            ex, ey, ez = f(consts[c, 3]), f(consts[c, 4]), f(consts[c, 5])
-            length, k, s, g = f(consts[c, 6]), f(consts[c, 7]), f(consts[c, 8]), f(consts[c, 9])
-            r1, r2 = f(consts[c, 10]), f(consts[c, 11])
-            cc = np.int32(c)
-            for i in range(lo, hi):
-                d = abs(_round_cone_distance(px[i], py[i], pz[i], ax, ay, az, ex, ey, ez, length, k, s, g, r1, r2))
-                current = best[i]
-                arg[i] = cc if d < current else arg[i]
-                best[i] = min(d, current)
-            # The block's largest distance: a max over the float32 bit patterns (ordered as the
-            # non-negative floats they encode), which vectorises where a float max does not.
-            top = np.int32(0)
-            for i in range(lo, hi):
-                top = max(top, best_bits[i])
-            scratch_bits[0] = top
-            worst = scratch[0]
+            d = abs(_round_cone_distance(px[i], py[i], pz[i], ax, ay, az, ex, ey, ez, length, k, s, g, r1, r2))
+            current = best[i]
+            arg[i] = cc if d < current else arg[i]
+            best[i] = min(d, current)
+        # The block's largest distance: a max over the float32 bit patterns (ordered as the
+        # non-negative floats they encode), which vectorises where a float max does not.
+        top = np.int32(0)
+        for i in range(lo, hi):
+            top = max(top, best_bits[i])
+        scratch_bits[0] = top
+        worst = scratch[0]
+    return visited
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
@@ -152,21 +191,33 @@ def nearest_capsules(a, b, radii, origin, px, py, pz, block_start, block_centre,
     """Each point's distance to the nearest capsule surface and that capsule, per particle.
 
     origin : (3,) float64; px, py, pz : (M,) float32, points minus origin, in blocks
-    (block_start (B + 1,) int64, block_centre (3, B) float64 minus origin, block_radius
-    (B,) float64; see :func:`_nearest_capsules`); distance : (P, M) float32 out, metres;
-    capsule : (P, M) int32 out.
+    (block b holds entries block_start[b] to block_start[b + 1] - 1; block_start (B + 1,)
+    int64, block_centre (3, B) float64 minus origin, block_radius (B,) float64: a ball
+    holding the block; see :func:`_nearest_in_block`); distance : (P, M) float32 out,
+    metres; capsule : (P, M) int32 out.
     """
+    num_capsules, num_blocks = a.shape[1], block_radius.shape[0]
     for p in numba.prange(a.shape[0]):
-        _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius,
-                          distance[p], capsule[p])
+        consts = np.empty((num_capsules, 12))
+        bounds = np.empty((num_capsules, num_blocks))
+        bound = np.empty(num_capsules)
+        order = np.empty(num_capsules, np.int64)
+        scratch = np.empty(1, np.float32)
+        best = distance[p]
+        _particle_bounds(a, b, radii, p, origin, block_centre, block_radius, consts, bounds)
+        for block in range(num_blocks):
+            _nearest_in_block(consts, bounds, block, px, py, pz, np.uint64(block_start[block]),
+                              np.uint64(block_start[block + 1]), best, capsule[p], bound, order, best.view(np.int32),
+                              scratch, scratch.view(np.int32))
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=True)
-def _capsule_sum(best, weight, arg, c):
-    """sum of weight * best over the entries with arg == c (float64; fastmath lets the sum
-    vectorise, which is faster than adding each point to its part's total in turn)."""
+def _capsule_sum(best, weight, arg, c, lo, hi):
+    """sum of weight * best over the entries lo..hi - 1 (uint64) with arg == c (float64;
+    fastmath lets the sum vectorise, which is faster than adding each point to its part's
+    total in turn)."""
     total = 0.0
-    for i in range(best.shape[0]):
+    for i in range(lo, hi):
         total += weight[i] * best[i] if arg[i] == c else np.float32(0.0)
     return total
 
@@ -176,57 +227,94 @@ def point_distance_sums(a, b, radii, capsule_part, origin, px, py, pz, block_sta
                         weight, out):
     """out[p, k] += sum of weight * distance over the points whose nearest capsule belongs to
     part k. Arguments as :func:`nearest_capsules`; weight : (M,) float32 (0 for padding);
-    out : (P, K) float64.
+    out : (P, K) float64. Each block's sums are taken over the capsules it visited, while
+    its points are in cache.
     """
     n = px.shape[0]
+    num_capsules, num_blocks = a.shape[1], block_radius.shape[0]
     for p in numba.prange(a.shape[0]):
+        consts = np.empty((num_capsules, 12))
+        bounds = np.empty((num_capsules, num_blocks))
+        bound = np.empty(num_capsules)
+        order = np.empty(num_capsules, np.int64)
+        scratch = np.empty(1, np.float32)
         best = np.empty(n, np.float32)
         arg = np.empty(n, np.int32)
-        _nearest_capsules(a, b, radii, p, origin, px, py, pz, block_start, block_centre, block_radius, best, arg)
-        for c in range(a.shape[1]):
-            out[p, capsule_part[c]] += _capsule_sum(best, weight, arg, np.int32(c))
+        best_bits = best.view(np.int32)
+        scratch_bits = scratch.view(np.int32)
+        _particle_bounds(a, b, radii, p, origin, block_centre, block_radius, consts, bounds)
+        for block in range(num_blocks):
+            lo, hi = np.uint64(block_start[block]), np.uint64(block_start[block + 1])
+            visited = _nearest_in_block(consts, bounds, block, px, py, pz, lo, hi, best, arg, bound, order,
+                                        best_bits, scratch, scratch_bits)
+            for j in range(visited):
+                c = order[j]
+                out[p, capsule_part[c]] += _capsule_sum(best, weight, arg, np.int32(c), lo, hi)
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def offset_depths(depth, table, step, sign, out):
+    """out = depth + sign * tolerance(depth) where depth > 0, else 0 (float32, metres).
+
+    depth : (H, W) float32, metres; table : (T,) float64, the tolerance at depths
+    0, step, 2 step, ... metres, linearly interpolated (depths beyond the table use its
+    last entry); sign : +1.0 or -1.0; out : (H, W) float32.
+    """
+    last = table.shape[0] - 1
+    inverse = 1.0 / step
+    for v in numba.prange(depth.shape[0]):
+        for u in range(depth.shape[1]):
+            d = np.float64(depth[v, u])
+            x = min(d * inverse, np.float64(last))
+            i = min(int(x), last - 1)
+            tolerance = table[i] + (x - i) * (table[i + 1] - table[i])
+            out[v, u] = d + sign * tolerance if d > 0.0 else 0.0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samples):
+def _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples):
     """Write the camera-facing samples of capsule ``c`` of particle ``p`` into ``samples``
-    (2 + T * A, 3), world metres: first the point of each end sphere nearest the camera
-    centre ``eye`` (the sphere's centre when the camera is inside it), then for each axis
-    fraction ``along[j]`` the points at the angles (cos_around, sin_around) about the axis,
-    from the direction facing the camera, on the circle of radius lerp(ra, rb, t) about
-    lerp(a, b, t). Every sample lies in the round cone.
+    (2 + T * A, 3), camera-frame metres (rotation (3, 3), shift (3,): camera_from_world):
+    first the point of each end sphere nearest the camera centre (the sphere's centre when
+    the camera is inside it), then for each axis fraction ``along[j]`` the points at the
+    angles (cos_around, sin_around) about the axis, from the direction facing the camera,
+    on the circle of radius lerp(ra, rb, t) about lerp(a, b, t). Every sample lies in the
+    round cone. Only the two ends are transformed; the samples are built in the camera
+    frame, where the camera centre is the origin.
     """
     ra, rb = radii[c, 0], radii[c, 1]
+    ax = rotation[0, 0] * a[p, c, 0] + rotation[0, 1] * a[p, c, 1] + rotation[0, 2] * a[p, c, 2] + shift[0]
+    ay = rotation[1, 0] * a[p, c, 0] + rotation[1, 1] * a[p, c, 1] + rotation[1, 2] * a[p, c, 2] + shift[1]
+    az = rotation[2, 0] * a[p, c, 0] + rotation[2, 1] * a[p, c, 1] + rotation[2, 2] * a[p, c, 2] + shift[2]
+    bx = rotation[0, 0] * b[p, c, 0] + rotation[0, 1] * b[p, c, 1] + rotation[0, 2] * b[p, c, 2] + shift[0]
+    by = rotation[1, 0] * b[p, c, 0] + rotation[1, 1] * b[p, c, 1] + rotation[1, 2] * b[p, c, 2] + shift[1]
+    bz = rotation[2, 0] * b[p, c, 0] + rotation[2, 1] * b[p, c, 1] + rotation[2, 2] * b[p, c, 2] + shift[2]
     for end in range(2):
-        r = ra if end == 0 else rb
-        for i in range(3):
-            samples[end, i] = a[p, c, i] if end == 0 else b[p, c, i]
-        wx, wy, wz = eye[0] - samples[end, 0], eye[1] - samples[end, 1], eye[2] - samples[end, 2]
-        norm = math.sqrt(wx * wx + wy * wy + wz * wz)
-        if norm > r:
-            samples[end, 0] += r * wx / norm
-            samples[end, 1] += r * wy / norm
-            samples[end, 2] += r * wz / norm
-    ex, ey, ez = b[p, c, 0] - a[p, c, 0], b[p, c, 1] - a[p, c, 1], b[p, c, 2] - a[p, c, 2]
-    length = math.sqrt(ex * ex + ey * ey + ez * ez)
+        x, y, z, r = (ax, ay, az, ra) if end == 0 else (bx, by, bz, rb)
+        norm = math.sqrt(x * x + y * y + z * z)
+        scale = 1.0 - r / norm if norm > r else 1.0
+        samples[end, 0] = x * scale
+        samples[end, 1] = y * scale
+        samples[end, 2] = z * scale
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    length = math.sqrt(dx * dx + dy * dy + dz * dz)
     if length > 0.0:
-        ex, ey, ez = ex / length, ey / length, ez / length
-    else:
-        ex, ey, ez = 0.0, 0.0, 1.0
+        ex, ey, ez = dx / length, dy / length, dz / length
+    else:  # the world's z axis
+        ex, ey, ez = rotation[0, 2], rotation[1, 2], rotation[2, 2]
     s = 2
     for j in range(along.shape[0]):
         t = along[j]
-        ox = a[p, c, 0] + t * (b[p, c, 0] - a[p, c, 0])
-        oy = a[p, c, 1] + t * (b[p, c, 1] - a[p, c, 1])
-        oz = a[p, c, 2] + t * (b[p, c, 2] - a[p, c, 2])
+        ox, oy, oz = ax + t * dx, ay + t * dy, az + t * dz
         r = ra + t * (rb - ra)
-        # n: towards the camera, square to the axis; m = e x n completes the frame.
-        wx, wy, wz = eye[0] - ox, eye[1] - oy, eye[2] - oz
-        dot = wx * ex + wy * ey + wz * ez
-        nx, ny, nz = wx - dot * ex, wy - dot * ey, wz - dot * ez
+        # n: towards the camera (-o), square to the axis; m = e x n completes the frame.
+        dot = -(ox * ex + oy * ey + oz * ez)
+        nx, ny, nz = -ox - dot * ex, -oy - dot * ey, -oz - dot * ez
         norm = math.sqrt(nx * nx + ny * ny + nz * nz)
-        if norm < 1e-9:  # camera on the axis: any square direction
-            nx, ny, nz = (1.0, 0.0, 0.0) if abs(ex) < 0.9 else (0.0, 1.0, 0.0)
+        if norm < 1e-9:  # camera on the axis: any square direction (the world's x or y axis)
+            world_x = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
+            k = 0 if abs(world_x) < 0.9 else 1
+            nx, ny, nz = rotation[0, k], rotation[1, k], rotation[2, k]
             dot = nx * ex + ny * ey + nz * ez
             nx, ny, nz = nx - dot * ex, ny - dot * ey, nz - dot * ez
             norm = math.sqrt(nx * nx + ny * ny + nz * nz)
@@ -241,43 +329,40 @@ def _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samp
 
 
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
-def _pixel(x, y, z, rotation, shift, fx, fy, cx, cy, height, width):
-    """Nearest pixel (v, u) and camera z of world point (x, y, z); v = -1 when it is behind
+def _pixel(xc, yc, zc, fx, fy, cx, cy, height, width):
+    """Nearest pixel (v, u) of camera-frame point (xc, yc, zc); v = -1 when it is behind
     the camera or outside the height x width image."""
-    xc = rotation[0, 0] * x + rotation[0, 1] * y + rotation[0, 2] * z + shift[0]
-    yc = rotation[1, 0] * x + rotation[1, 1] * y + rotation[1, 2] * z + shift[1]
-    zc = rotation[2, 0] * x + rotation[2, 1] * y + rotation[2, 2] * z + shift[2]
     if zc <= 0.0:
-        return -1, -1, zc
+        return -1, -1
     u = math.floor(fx * xc / zc + cx + 0.5)
     v = math.floor(fy * yc / zc + cy + 0.5)
     if u < 0 or v < 0 or u >= width or v >= height:
-        return -1, -1, zc
-    return int(v), int(u), zc
+        return -1, -1
+    return int(v), int(u)
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def free_space_penalties(a, b, radii, capsule_part, rotation, shift, eye, fx, fy, cx, cy, free_depth,
+def free_space_penalties(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, free_depth,
                          along, cos_around, sin_around, ramp, out):
     """out[p, k] += sum over part k's surface samples of their free-space penalty in one view.
 
-    rotation (3, 3), shift (3,) : camera_from_world; eye : (3,) the camera centre, world;
-    fx, fy, cx, cy : intrinsics (pixels); free_depth : (H, W) float32, metres, the depth
-    beyond which space is seen empty (measured depth minus the margin; 0 where nothing
-    was measured, which never penalises); along, cos_around, sin_around : the samples of
-    :func:`_surface_samples`; ramp : metres. A sample in the image whose pixel's free
-    depth f exceeds its camera depth zc costs min((f - zc) / ramp, 1).
+    rotation (3, 3), shift (3,) : camera_from_world; fx, fy, cx, cy : intrinsics (pixels);
+    free_depth : (H, W) float32, metres, the depth beyond which space is seen empty
+    (measured depth minus the margin; 0 where nothing was measured, which never
+    penalises); along, cos_around, sin_around : the samples of :func:`_camera_samples`;
+    ramp : metres. A sample in the image whose pixel's free depth f exceeds its camera
+    depth zc costs min((f - zc) / ramp, 1).
     """
     height, width = free_depth.shape
     num_samples = 2 + along.shape[0] * cos_around.shape[0]
     for p in numba.prange(a.shape[0]):
         samples = np.empty((num_samples, 3))
         for c in range(a.shape[1]):
-            _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samples)
+            _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples)
             total = 0.0
             for s in range(num_samples):
-                v, u, zc = _pixel(samples[s, 0], samples[s, 1], samples[s, 2], rotation, shift, fx, fy, cx, cy,
-                                  height, width)
+                zc = samples[s, 2]
+                v, u = _pixel(samples[s, 0], samples[s, 1], zc, fx, fy, cx, cy, height, width)
                 if v >= 0:
                     excess = free_depth[v, u] - zc
                     if excess > 0.0:
@@ -286,7 +371,7 @@ def free_space_penalties(a, b, radii, capsule_part, rotation, shift, eye, fx, fy
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def color_counts(a, b, radii, capsule_part, rotation, shift, eye, fx, fy, cx, cy, hidden_depth, cells,
+def color_counts(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, hidden_depth, cells,
                  along, cos_around, sin_around, counts):
     """counts[p, k, j] += how many of part k's surface samples land on a pixel of colour cell j.
 
@@ -302,11 +387,11 @@ def color_counts(a, b, radii, capsule_part, rotation, shift, eye, fx, fy, cx, cy
     for p in numba.prange(a.shape[0]):
         samples = np.empty((num_samples, 3))
         for c in range(a.shape[1]):
-            _surface_samples(a, b, radii, p, c, eye, along, cos_around, sin_around, samples)
+            _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples)
             k = capsule_part[c]
             for s in range(num_samples):
-                v, u, zc = _pixel(samples[s, 0], samples[s, 1], samples[s, 2], rotation, shift, fx, fy, cx, cy,
-                                  height, width)
+                zc = samples[s, 2]
+                v, u = _pixel(samples[s, 0], samples[s, 1], zc, fx, fy, cx, cy, height, width)
                 if v >= 0 and cells[v, u] >= 0:
                     hidden = hidden_depth[v, u]
                     if hidden == 0.0 or zc <= hidden:

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
+from occupose.likelihood import _kernels
 from occupose.synth.noise import depth_std
 
 #: Angles of the samples about a capsule's axis, either side of the camera-facing direction,
@@ -13,7 +16,7 @@ SAMPLE_SPAN_DEGREES = 45.0
 
 def sample_pattern(samples_along, samples_around):
     """Check the sample counts; return along (T,), cos_around (A,), sin_around (A,) float64
-    (see occupose.likelihood._kernels._surface_samples) and the samples per capsule, 2 + T A."""
+    (see occupose.likelihood._kernels._camera_samples) and the samples per capsule, 2 + T A."""
     for name, count in (("samples_along", samples_along), ("samples_around", samples_around)):
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise ValueError(f"{name} must be a positive integer, got {count!r}")
@@ -23,17 +26,36 @@ def sample_pattern(samples_along, samples_around):
     return along, np.cos(angles), np.sin(angles), 2 + int(samples_along) * int(samples_around)
 
 
-def depth_tolerance(depth: np.ndarray, margin: float, noise: str) -> np.ndarray:
-    """(H, W) float64 metres: ``margin`` + 3 sigma of the ``noise`` model's random error at
-    each measured depth (0 where depth is 0)."""
+#: Depth step of the tolerance tables of :func:`offset_depths`, metres (the tolerance is
+#: quadratic in depth: linear interpolation is exact to a few nanometres).
+TOLERANCE_STEP = 0.001
+
+
+@functools.lru_cache(maxsize=16)
+def _tolerance_table(margin: float, noise: str, metres: int) -> np.ndarray:
+    depths = np.arange(int(round(metres / TOLERANCE_STEP)) + 2) * TOLERANCE_STEP
+    return margin + 3.0 * depth_std(depths, noise)
+
+
+def offset_depths(depth: np.ndarray, margin: float, noise: str, sign: float) -> np.ndarray:
+    """(H, W) float32 metres: depth + sign * (``margin`` + 3 sigma of the ``noise`` model's
+    random error at that depth) on measured pixels, 0 where depth is 0.
+
+    depth : (H, W) float32, metres (0 = no measurement); sign : -1 (space seen empty
+    beyond) or +1 (hidden beyond).
+    """
     margin = float(margin)
     if not (np.isfinite(margin) and margin >= 0):
         raise ValueError(f"margin must be a finite number >= 0 metres, got {margin!r}")
-    depth = depth.astype(np.float64)
-    return np.where(depth > 0, margin + 3.0 * depth_std(depth, noise), 0.0)
+    depth_std(1.0, noise)  # raises with the valid names
+    depth = np.ascontiguousarray(depth, dtype=np.float32)
+    metres = int(np.ceil(depth.max())) if depth.size else 0
+    out = np.empty(depth.shape, np.float32)
+    _kernels.offset_depths(depth, _tolerance_table(margin, noise, max(metres, 1)), TOLERANCE_STEP, float(sign), out)
+    return out
 
 
 def camera_arrays(camera):
-    """rotation (3, 3) and shift (3,) of camera_from_world, and the camera centre (3,), world."""
+    """rotation (3, 3) and shift (3,) of camera_from_world."""
     pose = camera.camera_from_world
-    return np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3]), camera.position
+    return np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3])

@@ -21,7 +21,7 @@ import numpy as np
 
 from occupose.likelihood import _kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
-from occupose.likelihood._samples import camera_arrays, depth_tolerance, sample_pattern
+from occupose.likelihood._samples import camera_arrays, offset_depths, sample_pattern
 from occupose.likelihood.observation import Observation
 
 #: Default scale, nats for a part whose colours share nothing with its reference (d = 1).
@@ -73,9 +73,8 @@ class ColorLikelihood:
         for view in observation.views:
             if view.color is None:
                 continue
-            hidden = view.depth + depth_tolerance(view.depth, margin, noise)
-            hidden[view.depth == 0] = 0.0
-            self._views.append((*camera_arrays(view.camera), view.camera, np.ascontiguousarray(hidden, np.float32),
+            hidden = offset_depths(view.depth, margin, noise, 1.0)
+            self._views.append((*camera_arrays(view.camera), view.camera, hidden,
                                 color_cells(view.color, self.bins)))
         if not self._views:
             raise ValueError("the color likelihood needs an observation with at least one colour image")
@@ -89,8 +88,8 @@ class ColorLikelihood:
         The estimate's histograms are the next frame's reference."""
         a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
         counts = np.zeros((a.shape[0], num_parts, self.num_bins))
-        for rotation, shift, eye, cam, hidden, cells in self._views:
-            _kernels.color_counts(a, b, radii, capsule_part, rotation, shift, eye, cam.fx, cam.fy, cam.cx, cam.cy,
+        for rotation, shift, cam, hidden, cells in self._views:
+            _kernels.color_counts(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
                                   hidden, cells, self._along, self._cos, self._sin, counts)
         total = counts.sum(axis=2, keepdims=True)
         return np.divide(counts, total, out=counts, where=total > 0)

@@ -24,7 +24,7 @@ import numpy as np
 
 from occupose.likelihood import _kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
-from occupose.likelihood._samples import camera_arrays, depth_tolerance, sample_pattern
+from occupose.likelihood._samples import camera_arrays, offset_depths, sample_pattern
 from occupose.likelihood.observation import Observation
 
 #: Default weight, nats for a part wholly in seen-empty space. Calibrated as the points
@@ -63,18 +63,17 @@ class FreeSpaceLikelihood:
         self._along, self._cos, self._sin, self.samples_per_capsule = sample_pattern(samples_along, samples_around)
         self._views = []
         for view in observation.views:
-            free = view.depth - depth_tolerance(view.depth, margin, noise)
-            free[view.depth == 0] = 0.0
-            self._views.append((*camera_arrays(view.camera), view.camera, np.ascontiguousarray(free, np.float32)))
+            free = offset_depths(view.depth, margin, noise, -1.0)
+            self._views.append((*camera_arrays(view.camera), view.camera, free))
 
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """(P, K) float64 log-likelihoods of particles with capsules a, b (P, C, 3) metres,
         radii (C, 2) metres, capsule_part (C,) int in [0, num_parts)."""
         a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
         out = np.zeros((a.shape[0], num_parts))
-        for rotation, shift, eye, cam, free in self._views:
-            _kernels.free_space_penalties(a, b, radii, capsule_part, rotation, shift, eye, cam.fx, cam.fy, cam.cx,
-                                          cam.cy, free, self._along, self._cos, self._sin, self.ramp, out)
+        for rotation, shift, cam, free in self._views:
+            _kernels.free_space_penalties(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
+                                          free, self._along, self._cos, self._sin, self.ramp, out)
         samples = np.bincount(capsule_part, minlength=num_parts) * self.samples_per_capsule * len(self._views)
         out *= -self.weight / np.maximum(samples, 1)
         return out

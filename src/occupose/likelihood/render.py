@@ -73,7 +73,7 @@ class RenderLikelihood:
             z = observed.reshape(-1)[index]
             back = [(cols[gu] - cam.cx) / cam.fx * z, (rows[gv] - cam.cy) / cam.fy * z, z]
             self.num_observed += len(index)
-            self._views.append((*camera_arrays(cam)[:2], cam, u0, v0, np.ascontiguousarray(observed), index,
+            self._views.append((*camera_arrays(cam), cam, u0, v0, np.ascontiguousarray(observed), index,
                                 *(np.ascontiguousarray(c, dtype=np.float32) for c in back)))
 
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
