@@ -1,5 +1,5 @@
 """occupose.evaluate: the report and table formatting on hand-made scores, and one tiny
-evaluation end to end (no_occlusion, 30 procedural frames, `ours`) through the command line."""
+evaluation end to end (no_occlusion, 20 procedural frames, `ours`) through the command line."""
 
 import csv
 import math
@@ -16,7 +16,7 @@ from occupose.evaluate import (
 from occupose.joints import JOINTS
 from occupose.metrics import PersonScore, Score, TableRow
 
-FRAMES = 30
+FRAMES = 20
 
 
 def _row(mean_cm, fail=False, under10=50.0, coverage=100.0):

@@ -12,14 +12,18 @@ scores the runs against the ground truth and writes
   occlusions shaded; ``OUT/error_vs_time.png``: mean error against time per frame.
 
 Renders and runs go to a pool of worker processes (``spawn``), one per core, each with
-one numba thread: on the 2-core machine two single-threaded workers did the same runs in
-about half the time of one process using both cores through numba's parallel loops
-(most of a frame is serial Python and small kernels that one thread runs as fast as
-two). ``jobs=1`` runs everything in this process, with numba's default threads.
+one numba thread, so that two workers on two cores do not oversubscribe them. Measured on
+the 2-core machine (2 scenarios x 2 methods x 120 frames, recordings reused, other jobs
+running): two single-threaded workers took 48.8 and 56.0 s where one process with numba's
+2 threads took 66.9 and 70.5 s (load 4.5-6.4, about 1.3x faster); at load 6-7 both took
+57-71 s. Most of a frame is serial Python between small kernels, which a second numba
+thread does not speed up, so the pool is kept as the default. ``jobs=1`` runs
+everything in this process, with numba's default threads. Frames/s in the report are
+measured while the runs share the cores: ``occupose track`` alone is faster.
 
 Averaging rule: a row of the report's tables is the mean over the runs of each number
-(mean, std, percentages, coverage; runs without any estimate are left out of the mean
-and std, and FAIL), and its status is FAIL when *any* run FAILs.
+(mean, std, percentages, coverage; a run without any estimate has no mean or std and is
+left out of those, and FAILs), and its status is FAIL when *any* run FAILs.
 """
 
 from __future__ import annotations
@@ -221,7 +225,8 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
     out : folder for recordings/, runs/, results.csv, report.md and the plots
     frames : render and track at most this many frames of each scenario (None: all)
     procedural : procedural motion even when the shared mocap clips are present
-    jobs : worker processes (None: one per core; 1: everything in this process)
+    jobs : worker processes (None: one per core; never more than the runs; 1: everything
+        in this process)
     progress : callable(n, total) after n more frames were rendered or tracked, total
         being all the frames to render and track
     settings : tracker settings for every method (occupose.tracker.Tracker)
@@ -251,6 +256,7 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
                  out / "runs" / scenario / method / str(seed)) for method in methods for seed in range(runs)]
 
     results = []
+    jobs = min(jobs, len(scenarios) * len(methods) * runs)
     if jobs == 1:
         for scenario, task in renders.items():
             task[0](*task[1:], progress=report)
@@ -274,7 +280,7 @@ def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, settings) ->
     context = multiprocessing.get_context("spawn")
     frames_done = context.Queue()
     results = []
-    with ProcessPoolExecutor(min(jobs, sum(1 + len(runs_of(s)) for s in renders)), mp_context=context,
+    with ProcessPoolExecutor(jobs, mp_context=context,
                              initializer=_init_worker, initargs=(frames_done, 1)) as pool:
         pending: dict[Future, str | None] = {pool.submit(_in_worker, *task): scenario
                                              for scenario, task in renders.items()}
@@ -553,6 +559,9 @@ def _plot_errors(scenario, runs, methods, colors, hidden, person_ids, events, fp
     seconds = np.arange(hidden.shape[0]) / fps
     for p, ax in enumerate(axes[:, 0]):
         share = np.nan_to_num(hidden[:, p], nan=0.0)
+        for k, (start, stop) in enumerate(intervals_from_mask(np.isnan(hidden[:, p]))):
+            ax.axvspan(start / fps, stop / fps, facecolor="none", edgecolor="0.75", hatch="///", lw=0,
+                       label="not in view" if k == 0 else None)
         for low, shade, label in ((PARTLY_HIDDEN, "0.88", f">= {PARTLY_HIDDEN:.0%} joints hidden"),
                                   (MOSTLY_HIDDEN, "0.7", f">= {MOSTLY_HIDDEN:.0%} joints hidden")):
             for k, (start, stop) in enumerate(intervals_from_mask(share >= low)):
