@@ -10,10 +10,15 @@ annealing layers [3, 1, 1] over the three default partitioned-sampling stages (r
 head and arms, then legs: :func:`occupose.pose.default_stages`): 5 layers, i.e. 1000
 likelihood evaluations per frame.
 
-Measured (procedural no_occlusion, 90 frames, seeds 0-7): mean joint error 7.0, 6.4, 7.5,
-5.7, 5.7, 7.6, 8.7, 7.8 cm, never FAIL; the test takes the mean of seeds 0-2. The second
-paper's Fig. 5 claim (part-based beats a whole-body filter of the same budget on arm error)
-does not hold on our scenes and is not tested here (see benchmarks/bench_tracking.py).
+Measured (procedural no_occlusion, 90 frames, seeds 0-7): mean joint error 6.4, 6.4, 7.5,
+8.4, 5.9, 7.6, 6.4, 6.9 cm, never FAIL; the test takes the mean of seeds 0-2 (6.8 cm).
+
+The second paper's Fig. 5 claim, part-based beats a whole-body filter of the same budget on
+arm error, holds on procedural top_view_arms only against SIR at 250 evaluations per frame
+(arm error over seeds 0-3: part-based 12.5, 12.4, 11.9, 12.4 cm; sir 14.9, 14.9, 12.0,
+13.1 cm), which is what is tested. It does not hold at 500 (part-based 11.9 cm mean over
+the seeds, sir 10.5) or 1000 evaluations (11.4 vs 10.1), nor against apf at any of these
+budgets (apf 200 x 5: 6.6 cm; see benchmarks/bench_tracking.py).
 """
 
 from __future__ import annotations
@@ -127,6 +132,23 @@ def test_log_likelihood_per_part_true_pose_beats_perturbed_and_hidden_parts_give
                           np.delete(values, model.part_names.index("left_shin"), axis=1))
 
 
+def test_part_weights_chain_weighs_each_group_by_its_chain_to_the_root():
+    model = body_model("upper")
+    names = model.part_names
+    own = PoseProblem(model, part_weights="own").weight_groups
+    chain = PoseProblem(model).weight_groups
+    assert [list(g.parts) for g in own] == [list(g.parts) for g in model.weight_groups]
+    assert [list(g.dofs) for g in chain] == [list(g.dofs) for g in model.weight_groups]
+    by_dof = {int(g.dofs[0]): {names[k] for k in g.parts} for g in chain}
+    assert by_dof[0] == set(names)  # the root translation moves every part
+    right_arm = next(g for g in model.weight_groups if names[g.parts[0]] == "right_arm")
+    right = by_dof[int(right_arm.dofs[0])]
+    assert "right_arm" in right and "left_arm" not in right and "head" not in right
+    assert {"shoulders", "torso"} <= right
+    with pytest.raises(ValueError, match="unknown part_weights 'best'; valid names: chain, own"):
+        PoseProblem(model, part_weights="best")
+
+
 def test_problem_rejects_unknown_likelihood(walk):
     problem = PoseProblem(body_model("full"), "no-such-term")
     with pytest.raises(ValueError, match="unknown likelihood 'no-such-term'; valid names"):
@@ -224,16 +246,32 @@ def test_apf_ps_200_x_5_layers_tracks_a_walk_within_8_cm(walk):
 
 def test_upper_model_tracks_waving_arms_from_the_ceiling(top_view):
     """Whole-body apf+ps (200 x [3, 2] = 1000 evaluations) on top_view_arms with the upper
-    model: the arms (elbows and wrists) within 11 cm on average, no FAIL. (Measured seeds
-    0, 1: mean 4.6, 4.0 cm, arms 8.1, 7.2 cm; apf 200 x 5 arms 9.9, 8.6; sir 1000 15.4,
-    16.1; part-based 1000: 22.4, 28.8 cm.)"""
+    model: the arms (elbows and wrists) within 9 cm on average, no FAIL. (Measured seeds
+    0-3: mean 3.7, 3.6, 3.1, 3.8 cm, arms 6.2, 5.8, 5.0, 6.6 cm.)"""
     gt, observations = top_view
     estimator = _estimator("upper", gt, "apf+ps", 200, 0, num_layers=[3, 2])
     errors = _track(estimator, gt, observations)
     assert estimator.filter.diagnostics["likelihood_evaluations"] == 1000
     assert np.all(np.isnan(errors[:, JOINT_INDEX["left_knee"]]))
     assert not is_fail(frame_errors(errors), 30.0)
-    assert np.nanmean(errors[:, ARMS]) <= 0.11
+    assert np.nanmean(errors[:, ARMS]) <= 0.09
+
+
+def test_part_based_beats_sir_on_the_arms_at_250_evaluations(top_view):
+    """The second paper's Fig. 5 claim where it holds here: on top_view_arms (upper model),
+    part-based with 250 particles (one likelihood call, 250 evaluations) has a lower arm
+    error than SIR with 250 particles, over seeds 0-3 (measured 12.3 vs 13.7 cm; neither
+    FAILs). At 500 and 1000 evaluations SIR is better, and apf is better at every budget."""
+    gt, observations = top_view
+    arm_errors = {"part-based": [], "sir": []}
+    for name in arm_errors:
+        for seed in range(4):
+            estimator = _estimator("upper", gt, name, 250, seed)
+            errors = _track(estimator, gt, observations)
+            assert estimator.filter.diagnostics["likelihood_evaluations"] == 250
+            assert not is_fail(frame_errors(errors), 30.0)
+            arm_errors[name].append(np.nanmean(errors[:, ARMS]))
+    assert np.mean(arm_errors["part-based"]) < np.mean(arm_errors["sir"]), arm_errors
 
 
 def test_apf_ps_tracks_a_mocap_walk(mocap):
