@@ -414,17 +414,19 @@ def per_joint_table(runs: Sequence[RunResult]) -> dict[str, dict[str, float]]:
 
 
 def speed_table(runs: Sequence[RunResult]) -> dict[str, dict[str, float]]:
-    """{method: {"fps": mean frames/s, "ms": mean ms/frame, "<stage> ms": ms/frame per
-    stage}} over all runs, the first (start-up) frame excluded from fps and ms."""
+    """{method: {"fps": frames/s, "ms": ms/frame, "<stage> ms": ms/frame per stage}} over
+    all runs of the method pooled (all frames over all seconds); fps and ms leave out the
+    first (start-up) frame of each run, the stage times include it."""
     out = {}
     for method in dict.fromkeys(r.method for r in runs):
         mine = [r for r in runs if r.method == method]
-        frames = [max(len(r.frame_errors) - 1, 1) for r in mine]
-        entry = {"fps": float(np.mean([r.fps for r in mine])),
-                 "ms": float(np.mean([1000.0 * r.seconds.get("total", math.nan) / n for r, n in zip(mine, frames)]))}
+        frames = sum(len(r.frame_errors) for r in mine)
+        seconds = sum(r.seconds.get("total", math.nan) for r in mine)
+        ms = 1000.0 * seconds / max(frames - len(mine), 1)
+        entry = {"fps": 1000.0 / ms if ms > 0 else math.nan, "ms": ms}
         for key in _seconds_keys(mine):
             if key not in ("total", "startup"):
-                entry[f"{key} ms"] = float(np.mean([1000.0 * r.seconds[key] / (n + 1) for r, n in zip(mine, frames)]))
+                entry[f"{key} ms"] = 1000.0 * sum(r.seconds.get(key, math.nan) for r in mine) / max(frames, 1)
         out[method] = entry
     return out
 
