@@ -16,10 +16,14 @@ to the right person (tracks mapped to people by majority overlap over the whole 
 an identity swap would count as wrong), mean and minimum over the frames where both
 people are present and some pixel is assigned; ``precision``/``recall`` of the assigned
 pixels as foreground against the renderer's person image (and ``iou``); ``id_swaps`` = frames whose own
-majority mapping disagrees with the whole run's. Moving cells from the HMM grid (for the
-top view after 5 frames of the empty room: the people stand still from frame 0) or from
+majority mapping disagrees with the whole run's. Moving cells from the HMM grid or from
 the perfect mask of (a); the exclusion principle's bodies: the previous frame's
 observation (`predicted_from_tracks`), the tracker's cell shares, or the centroid fallback.
+``hold``: the grid's hold mask (`OccupancyGrid.update`), which keeps people who stand still
+moving: ``true bodies`` = cells within MARGIN (0.1 m) of the capsules covering the true
+bodies of the frame (`capsules_from_primitives`: a perfect prediction, standing in for the
+tracker's predicted bodies), ``previous blobs`` = the cells of the previous frame's tracked
+blobs dilated by a ball of 0.1 m, ``none`` = no hold (people fade after 77 frames still).
 """
 
 from __future__ import annotations
@@ -30,7 +34,10 @@ import time
 import numpy as np
 
 from occupose.camera import points_from_depth
+from scipy import ndimage
+
 from occupose.grid.blobs import blobs_from_mask
+from occupose.grid.hold import MARGIN, capsules_from_primitives, cells_near_capsules
 from occupose.grid.observation import (
     distance_to_points, observations_from_depth, persons_from_tracks, predicted_from_tracks,
 )
@@ -48,6 +55,9 @@ from occupose.synth.scenarios import build_scenario
 TITLE = "Blobs: labelling + blob tracking on 80x80x50 cells, and per-person observations (ms per frame)"
 ACCURACY_TITLE = "Blobs: pixel assignment between two people (exclusion principle)"
 BOX = GridSpec((-2.0, 1.5, -0.025), 0.05, (80, 80, 50))
+#: Dilation of the previous frame's blob cells for the "previous blobs" hold: a ball of
+#: two cells' radius (MARGIN = 0.1 m).
+_BALL = np.sum(np.mgrid[-2:3, -2:3, -2:3] ** 2, axis=0) <= 4
 OFFSETS = ((0.0, 0.0), (0.5, 0.8), (-0.5, -0.8))
 
 
@@ -132,26 +142,41 @@ def _bodies(kind, tracker, previous, fps, tracks):
     return {}  # centroid fallback only
 
 
-def _runs(name, pipelines, *, warm_up=0, seed=0):
-    """Run the stages over every frame; pipelines: list of (moving cells source, body kind).
-    Returns per pipeline the per-frame (assigned image, truth image, present)."""
+def _hold(mode, frame, scenario, spec, tracker):
+    """The grid's hold mask for this frame (None: no hold)."""
+    if mode == "true bodies":
+        bodies = [primitives_from_joints(frame.joints[p], person.shape, p + 1)
+                  for p, person in enumerate(scenario.people) if frame.present[p]]
+        return cells_near_capsules(spec, *capsules_from_primitives(concat(bodies)), MARGIN)
+    if mode == "previous blobs":
+        mask = np.zeros(spec.num_cells, bool)
+        for state in tracker.states.values():
+            if state.blob is not None:
+                mask[state.blob.cells] = True
+        return ndimage.binary_dilation(mask.reshape(spec.shape), _BALL)
+    return None
+
+
+def _runs(name, pipelines, *, seed=0):
+    """Run the stages over every frame; pipelines: list of (hold, moving cells source, body
+    kind), one grid per hold mode. Returns per pipeline the per-frame (assigned image, truth
+    image, present)."""
     scenario = build_scenario(name, use_mocap=False)
     cam = scenario.cameras[0]
     spec = spec_from_cameras(scenario.cameras)
-    grid = OccupancyGrid(spec, scenario.cameras)
-    rng = np.random.default_rng(seed + 1000)
-    room = render_camera(scenario.static, cam).depth
-    model, options = scenario.noise[cam.name]
-    for _ in range(warm_up):
-        grid.update({cam.name: apply_noise(room, model, rng, fx=cam.fx, **options)})
+    grids = {hold: OccupancyGrid(spec, scenario.cameras) for hold, _, _ in pipelines}
     trackers = [BlobTracker(scenario.fps) for _ in pipelines]
+    # the tracker whose blobs hold the cells of the "previous blobs" grid
+    holder = {hold: trackers[p] for p, (hold, source, _) in enumerate(pipelines) if source == "HMM grid"}
     previous = [{} for _ in pipelines]
     out = [[] for _ in pipelines]
     for frame in frames(scenario, seed):
         truth = frame.rendered[cam.name].person.astype(np.int64)
-        grid.update(frame.depth)
+        for hold, grid in grids.items():
+            grid.update(frame.depth, hold=_hold(hold, frame, scenario, spec, holder.get(hold)))
         oracle = _mask_of_points(points_from_depth(np.where(truth > 0, frame.depth[cam.name], 0), cam)[0], spec)
-        for p, (source, kind) in enumerate(pipelines):
+        for p, (hold, source, kind) in enumerate(pipelines):
+            grid = grids[hold]
             moving, states = (grid.moving_mask(), grid.states) if source == "HMM grid" else (oracle, None)
             labels, blobs = blobs_from_mask(moving, spec)
             tracks = trackers[p].update(blobs)
@@ -190,23 +215,22 @@ def _score(run, frames_from=0, frames_to=None) -> dict:
 
 
 def run_accuracy() -> list[dict]:
-    """One dict per (scenario, moving cells, bodies, frames): the scores of ``_score``."""
+    """One dict per (scenario, hold, moving cells, bodies): the scores of ``_score`` over all frames."""
     rows = []
-    crossing = _runs("two_people_crossing", [("HMM grid", "previous observation"),
-                                             ("HMM grid", "centroid fallback")])
-    for (source, kind), run in zip([("HMM grid", "previous observation"), ("HMM grid", "centroid fallback")], crossing):
-        rows.append({"scenario": "two_people_crossing", "moving_cells": source, "bodies": kind,
-                     "range": "all", **_score(run)})
-    pipelines = [("HMM grid", "previous observation"), ("perfect mask", "previous observation"),
-                 ("perfect mask", "tracker cell shares"), ("perfect mask", "centroid fallback")]
-    top = _runs("top_view_two_people", pipelines, warm_up=5)
-    rows.append({"scenario": "top_view_two_people", "moving_cells": "HMM grid (5 empty-room frames first)",
-                 "bodies": "previous observation", "range": "0-26", **_score(top[0], 0, 27)})
-    for (source, kind), run in zip(pipelines, top):
-        if source == "HMM grid":
-            source = "HMM grid (5 empty-room frames first)"
-        rows.append({"scenario": "top_view_two_people", "moving_cells": source, "bodies": kind,
-                     "range": "all", **_score(run)})
+    for name, pipelines in (
+        ("two_people_crossing", [("true bodies", "HMM grid", "previous observation"),
+                                 ("true bodies", "HMM grid", "centroid fallback"),
+                                 ("none", "HMM grid", "previous observation")]),
+        ("top_view_two_people", [("true bodies", "HMM grid", "previous observation"),
+                                 ("previous blobs", "HMM grid", "previous observation"),
+                                 ("none", "HMM grid", "previous observation"),
+                                 ("none", "perfect mask", "previous observation"),
+                                 ("none", "perfect mask", "tracker cell shares"),
+                                 ("none", "perfect mask", "centroid fallback")]),
+    ):
+        for (hold, source, kind), run in zip(pipelines, _runs(name, pipelines)):
+            rows.append({"scenario": name, "hold": hold if source == "HMM grid" else "-", "moving_cells": source,
+                         "bodies": kind, "range": "all", **_score(run)})
     return rows
 
 

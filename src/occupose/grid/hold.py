@@ -7,7 +7,16 @@ it follows: it passes a hold mask to :meth:`occupose.grid.occupancy.OccupancyGri
 which disables the M -> O transition in those cells for that frame. This module makes that
 mask from the round cones of the predicted bodies (``occupose.body.capsules_from_poses``),
 and, for tests and benchmarks that hold the true bodies, gives the capsules covering a
-rendered body (:func:`capsules_from_primitives`).
+rendered body (:func:`capsules_from_primitives`). For a body model's predicted pose::
+
+    a, b = capsules_from_poses(model, pose[None])            # (1, C, 3) each
+    hold = cells_near_capsules(grid.spec, a[0], b[0], model.capsule_radii)
+    grid.update(depths, hold=hold)                           # several people: OR their masks
+
+Measured on the synthetic scenes with the true bodies held (benchmarks/bench_blobs.py):
+pixel assignment over all 300 frames of ``top_view_two_people`` 99.6 % (72 % without the
+hold, where the still bodies fade); holding the previous frame's blob cells dilated by
+0.1 m instead gave 90.6 % with identity swaps.
 """
 
 from __future__ import annotations
