@@ -253,34 +253,37 @@ def point_distance_sums(a, b, radii, capsule_part, origin, px, py, pz, block_sta
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def offset_depths(depth, table, step, sign, out):
+def offset_depths(depth, table, slope, step, sign, out):
     """out = depth + sign * tolerance(depth) where depth > 0, else 0 (float32, metres).
 
-    depth : (H, W) float32, metres; table : (T,) float64, the tolerance at depths
-    0, step, 2 step, ... metres, linearly interpolated (depths beyond the table use its
-    last entry); sign : +1.0 or -1.0; out : (H, W) float32.
+    depth : (H, W) float32, metres; table : (T,) float32, the tolerance at depths 0, step,
+    2 step, ... metres, and slope : (T - 1,) float32 its differences, for linear
+    interpolation (the table must cover the depths: larger ones get the tolerance at
+    (T - 2) step); sign : +1.0 or -1.0; out : (H, W) float32. float32 throughout, so that
+    the loop vectorises.
     """
-    last = table.shape[0] - 1
-    inverse = 1.0 / step
+    last = np.float32(slope.shape[0] - 1)
+    inverse = np.float32(1.0 / step)
+    sign32 = np.float32(sign)
     for v in numba.prange(depth.shape[0]):
         for u in range(depth.shape[1]):
-            d = np.float64(depth[v, u])
-            x = min(d * inverse, np.float64(last))
-            i = min(int(x), last - 1)
-            tolerance = table[i] + (x - i) * (table[i + 1] - table[i])
-            out[v, u] = d + sign * tolerance if d > 0.0 else 0.0
+            d = depth[v, u]
+            x = min(d * inverse, last)
+            i = np.int32(x)
+            value = d + sign32 * (table[i] + (x - np.float32(i)) * slope[i])
+            out[v, u] = value if d > 0 else np.float32(0.0)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples):
     """Write the camera-facing samples of capsule ``c`` of particle ``p`` into ``samples``
-    (2 + T * A, 3), camera-frame metres (rotation (3, 3), shift (3,): camera_from_world):
-    first the point of each end sphere nearest the camera centre (the sphere's centre when
-    the camera is inside it), then for each axis fraction ``along[j]`` the points at the
-    angles (cos_around, sin_around) about the axis, from the direction facing the camera,
-    on the circle of radius lerp(ra, rb, t) about lerp(a, b, t). Every sample lies in the
-    round cone. Only the two ends are transformed; the samples are built in the camera
-    frame, where the camera centre is the origin.
+    (3, 2 + T * A), camera-frame metres, x, y, z rows (rotation (3, 3), shift (3,):
+    camera_from_world): first the point of each end sphere nearest the camera centre (the
+    sphere's centre when the camera is inside it), then for each axis fraction ``along[j]``
+    the points at the angles (cos_around, sin_around) about the axis, from the direction
+    facing the camera, on the circle of radius lerp(ra, rb, t) about lerp(a, b, t). Every
+    sample lies in the round cone. Only the two ends are transformed; the samples are
+    built in the camera frame, where the camera centre is the origin.
     """
     ra, rb = radii[c, 0], radii[c, 1]
     ax = rotation[0, 0] * a[p, c, 0] + rotation[0, 1] * a[p, c, 1] + rotation[0, 2] * a[p, c, 2] + shift[0]
@@ -293,13 +296,14 @@ def _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_a
         x, y, z, r = (ax, ay, az, ra) if end == 0 else (bx, by, bz, rb)
         norm = math.sqrt(x * x + y * y + z * z)
         scale = 1.0 - r / norm if norm > r else 1.0
-        samples[end, 0] = x * scale
-        samples[end, 1] = y * scale
-        samples[end, 2] = z * scale
+        samples[0, end] = x * scale
+        samples[1, end] = y * scale
+        samples[2, end] = z * scale
     dx, dy, dz = bx - ax, by - ay, bz - az
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     if length > 0.0:
-        ex, ey, ez = dx / length, dy / length, dz / length
+        inverse = 1.0 / length
+        ex, ey, ez = dx * inverse, dy * inverse, dz * inverse
     else:  # the world's z axis
         ex, ey, ez = rotation[0, 2], rotation[1, 2], rotation[2, 2]
     s = 2
@@ -318,27 +322,29 @@ def _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_a
             dot = nx * ex + ny * ey + nz * ez
             nx, ny, nz = nx - dot * ex, ny - dot * ey, nz - dot * ez
             norm = math.sqrt(nx * nx + ny * ny + nz * nz)
-        nx, ny, nz = nx / norm, ny / norm, nz / norm
+        inverse = r / norm
+        nx, ny, nz = nx * inverse, ny * inverse, nz * inverse  # radius r
         mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
         for i in range(cos_around.shape[0]):
-            co, si = r * cos_around[i], r * sin_around[i]
-            samples[s, 0] = ox + co * nx + si * mx
-            samples[s, 1] = oy + co * ny + si * my
-            samples[s, 2] = oz + co * nz + si * mz
+            co, si = cos_around[i], sin_around[i]
+            samples[0, s] = ox + co * nx + si * mx
+            samples[1, s] = oy + co * ny + si * my
+            samples[2, s] = oz + co * nz + si * mz
             s += 1
 
 
-@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
-def _pixel(xc, yc, zc, fx, fy, cx, cy, height, width):
-    """Nearest pixel (v, u) of camera-frame point (xc, yc, zc); v = -1 when it is behind
-    the camera or outside the height x width image."""
-    if zc <= 0.0:
-        return -1, -1
-    u = math.floor(fx * xc / zc + cx + 0.5)
-    v = math.floor(fy * yc / zc + cy + 0.5)
-    if u < 0 or v < 0 or u >= width or v >= height:
-        return -1, -1
-    return int(v), int(u)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _sample_pixels(samples, fx, fy, cx, cy, height, width, pixel):
+    """pixel[s] = v * width + u, the nearest pixel (v, u) of camera-frame sample s of
+    ``samples`` (3, S), or -1 when it is behind the camera or outside the height x width
+    image; pixel : (S,) int32 (branch-free, vectorised over the samples)."""
+    for s in range(samples.shape[1]):
+        z = samples[2, s]
+        inverse = 1.0 / z
+        u = np.floor(fx * samples[0, s] * inverse + cx + 0.5)
+        v = np.floor(fy * samples[1, s] * inverse + cy + 0.5)
+        inside = (z > 0.0) & (u >= 0.0) & (v >= 0.0) & (u < width) & (v < height)
+        pixel[s] = np.int32(v * width + u) if inside else np.int32(-1)
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
@@ -354,19 +360,20 @@ def free_space_penalties(a, b, radii, capsule_part, rotation, shift, fx, fy, cx,
     depth zc costs min((f - zc) / ramp, 1).
     """
     height, width = free_depth.shape
+    flat = free_depth.reshape(-1)
     num_samples = 2 + along.shape[0] * cos_around.shape[0]
+    inverse_ramp = 1.0 / ramp
     for p in numba.prange(a.shape[0]):
-        samples = np.empty((num_samples, 3))
+        samples = np.empty((3, num_samples))
+        pixel = np.empty(num_samples, np.int32)
         for c in range(a.shape[1]):
             _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples)
+            _sample_pixels(samples, fx, fy, cx, cy, height, width, pixel)
             total = 0.0
             for s in range(num_samples):
-                zc = samples[s, 2]
-                v, u = _pixel(samples[s, 0], samples[s, 1], zc, fx, fy, cx, cy, height, width)
-                if v >= 0:
-                    excess = free_depth[v, u] - zc
-                    if excess > 0.0:
-                        total += min(excess / ramp, 1.0)
+                q = pixel[s]
+                if q >= 0:  # branch-free below: whether a sample is penalised is unpredictable
+                    total += min(max(flat[q] - samples[2, s], 0.0) * inverse_ramp, 1.0)
             out[p, capsule_part[c]] += total
 
 
@@ -383,19 +390,22 @@ def color_counts(a, b, radii, capsule_part, rotation, shift, fx, fy, cx, cy, hid
     part or, where the part is misplaced, whatever lies behind it.
     """
     height, width = cells.shape
+    flat_hidden = hidden_depth.reshape(-1)
+    flat_cells = cells.reshape(-1)
     num_samples = 2 + along.shape[0] * cos_around.shape[0]
     for p in numba.prange(a.shape[0]):
-        samples = np.empty((num_samples, 3))
+        samples = np.empty((3, num_samples))
+        pixel = np.empty(num_samples, np.int32)
         for c in range(a.shape[1]):
             _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples)
+            _sample_pixels(samples, fx, fy, cx, cy, height, width, pixel)
             k = capsule_part[c]
             for s in range(num_samples):
-                zc = samples[s, 2]
-                v, u = _pixel(samples[s, 0], samples[s, 1], zc, fx, fy, cx, cy, height, width)
-                if v >= 0 and cells[v, u] >= 0:
-                    hidden = hidden_depth[v, u]
-                    if hidden == 0.0 or zc <= hidden:
-                        counts[p, k, cells[v, u]] += 1.0
+                q = pixel[s]
+                if q >= 0 and flat_cells[q] >= 0:
+                    hidden = flat_hidden[q]
+                    if hidden == 0.0 or samples[2, s] <= hidden:
+                        counts[p, k, flat_cells[q]] += 1.0
 
 
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")

@@ -32,9 +32,10 @@ TOLERANCE_STEP = 0.001
 
 
 @functools.lru_cache(maxsize=16)
-def _tolerance_table(margin: float, noise: str, metres: int) -> np.ndarray:
+def _tolerance_table(margin: float, noise: str, metres: int) -> tuple[np.ndarray, np.ndarray]:
     depths = np.arange(int(round(metres / TOLERANCE_STEP)) + 2) * TOLERANCE_STEP
-    return margin + 3.0 * depth_std(depths, noise)
+    table = margin + 3.0 * depth_std(depths, noise)
+    return table.astype(np.float32), np.diff(table).astype(np.float32)
 
 
 def offset_depths(depth: np.ndarray, margin: float, noise: str, sign: float) -> np.ndarray:
@@ -51,7 +52,7 @@ def offset_depths(depth: np.ndarray, margin: float, noise: str, sign: float) -> 
     depth = np.ascontiguousarray(depth, dtype=np.float32)
     metres = int(np.ceil(depth.max())) if depth.size else 0
     out = np.empty(depth.shape, np.float32)
-    _kernels.offset_depths(depth, _tolerance_table(margin, noise, max(metres, 1)), TOLERANCE_STEP, float(sign), out)
+    _kernels.offset_depths(depth, *_tolerance_table(margin, noise, max(metres, 1)), TOLERANCE_STEP, float(sign), out)
     return out
 
 
