@@ -133,6 +133,22 @@ def test_kernel_matches_numpy_reference(name, rng):
     assert np.isnan(joints[:, J["left_knee"]]).all() == (name == "upper")
 
 
+def test_serial_and_parallel_kernels_agree(rng):
+    from occupose.body import _kernels
+    from occupose.body.kinematics import _tree
+
+    m = BODY_MODELS["full"]
+    poses = _random_poses(m, rng, _kernels.SERIAL_POSES + 37)  # more than the serial kernel takes
+    a, b = capsules_from_poses(m, poses)
+    serial = np.empty_like(a), np.empty_like(b)
+    _kernels.points_from_poses_serial(poses, *_tree(m), m.capsule_nodes[0], m.capsule_offsets[0], serial[0],
+                                      m.capsule_nodes[1], m.capsule_offsets[1], serial[1])
+    np.testing.assert_array_equal(a, serial[0])
+    np.testing.assert_array_equal(b, serial[1])
+    np.testing.assert_allclose(a[-3:], _points_reference(m, poses[-3:], m.capsule_nodes[0], m.capsule_offsets[0]),
+                               atol=1e-12)
+
+
 def test_kernel_sincos_matches_libm(rng):
     from occupose.body._kernels import sincos
 

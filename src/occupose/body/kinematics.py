@@ -26,6 +26,11 @@ def _tree(model: BodyModel):
     return (model.parents, model.offsets, model.dof_node, model.dof_type, model.dof_axis, model.dof_sign)
 
 
+def _kernel(num_poses: int):
+    """The forward-kinematics kernel for this many poses (serial for a few hundred)."""
+    return _kernels.points_from_poses_serial if num_poses <= _kernels.SERIAL_POSES else _kernels.points_from_poses
+
+
 def capsules_from_poses(model: BodyModel, poses) -> tuple[np.ndarray, np.ndarray]:
     """World ends of every round cone of the model for each pose.
 
@@ -37,8 +42,8 @@ def capsules_from_poses(model: BodyModel, poses) -> tuple[np.ndarray, np.ndarray
     num = poses.shape[0]
     a = np.empty((num, model.num_capsules, 3))
     b = np.empty((num, model.num_capsules, 3))
-    _kernels.points_from_poses(poses, *_tree(model), model.capsule_nodes[0], model.capsule_offsets[0], a,
-                               model.capsule_nodes[1], model.capsule_offsets[1], b)
+    _kernel(num)(poses, *_tree(model), model.capsule_nodes[0], model.capsule_offsets[0], a,
+                 model.capsule_nodes[1], model.capsule_offsets[1], b)
     return a, b
 
 
@@ -51,6 +56,6 @@ def joints_from_poses(model: BodyModel, poses) -> np.ndarray:
     """
     poses = _check_poses(model, poses)
     out = np.empty((poses.shape[0], NUM_JOINTS, 3))
-    _kernels.points_from_poses(poses, *_tree(model), model.joint_nodes, model.joint_offsets, out,
-                               _EMPTY_NODES, _EMPTY_OFFSETS, np.empty((poses.shape[0], 0, 3)))
+    _kernel(poses.shape[0])(poses, *_tree(model), model.joint_nodes, model.joint_offsets, out,
+                            _EMPTY_NODES, _EMPTY_OFFSETS, np.empty((poses.shape[0], 0, 3)))
     return out
