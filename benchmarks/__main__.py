@@ -14,10 +14,11 @@ from benchmarks import (
     bench_grid,
     bench_likelihood,
     bench_render,
+    bench_tracking,
     format_table,
 )
 
-BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters]
+BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking]
 
 
 def machine() -> str:
