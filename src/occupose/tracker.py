@@ -110,6 +110,9 @@ MIN_INIT_POINTS = 200
 #: points pooled (the grid extracts a newly moving body over a few frames, so the first
 #: frames' points fall short of the head).
 INIT_FRAMES = 5
+#: A person whose pixels come within this many pixels of the left, right or top image edge
+#: is not fully in view and does not start yet.
+BORDER_PX = 3
 #: Headings tried when a person starts, radians.
 INIT_HEADINGS = np.linspace(-np.pi, np.pi, 12, endpoint=False)
 #: Seat height of the sitting start, as a share of the stature (0.45 m for 1.75 m).
@@ -130,6 +133,11 @@ CARRY_SPEED = 0.067
 #: Largest horizontal offset between the pelvis and its blob's centroid kept for placing
 #: a person that is back, metres.
 MAX_ANCHOR = 0.25
+#: A person starting faster than this walks: it starts facing the way it walks, m/s.
+WALKING_SPEED = 0.3
+#: A new blob track within this distance of a lost person's carried pelvis is that
+#: person's, metres (horizontal).
+REJOIN_M = 1.0
 #: Hip flexions and knee bends tried when placing hidden legs (:func:`planted_legs`), radians.
 PLANT_HIP = np.linspace(0.0, 1.8, 19)
 PLANT_KNEE = np.linspace(0.0, 2.2, 23)
@@ -291,6 +299,7 @@ class _Person:
         self.centroid: np.ndarray | None = None  # (3,) its blob's centroid when last seen
         self.anchor = np.zeros(2)  # pelvis x, y minus its blob's centroid x, y at the last estimate
         self.lost = False  # gone or suspended since the last estimate
+        self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
         self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
         self.part_visible = np.ones(model.num_parts, bool)
 
@@ -332,10 +341,29 @@ def joints_of(model: BodyModel, pose: np.ndarray) -> np.ndarray:
     return joints_from_poses(model, np.asarray(pose, float)[None])[0]
 
 
-def start_candidates(model: BodyModel, centroid: np.ndarray) -> np.ndarray:
+def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera) -> np.ndarray:
+    """The headings of INIT_HEADINGS a person may start with, radians: those within 90
+    degrees of where they walk (``velocity`` (2,) m/s, when faster than WALKING_SPEED),
+    else of the direction towards ``camera`` from ``centroid`` (3,) metres.
+
+    A body of round cones fits its points about as well facing either way (front and
+    back differ little in depth), so the likelihood alone picks the wrong half turn about
+    as often as the right one, which swaps left and right for good; people mostly face
+    where they walk, and a person standing in view of a camera more often faces it.
+    """
+    if np.hypot(*velocity) > WALKING_SPEED:
+        facing = np.arctan2(velocity[1], velocity[0])
+    else:
+        to_camera = camera.world_from_camera[:2, 3] - centroid[:2]
+        facing = np.arctan2(to_camera[1], to_camera[0])
+    off = (INIT_HEADINGS - facing + np.pi) % (2 * np.pi) - np.pi
+    return INIT_HEADINGS[np.abs(off) < np.pi / 2 + 1e-9]
+
+
+def start_candidates(model: BodyModel, centroid: np.ndarray, headings: np.ndarray = INIT_HEADINGS) -> np.ndarray:
     """(S, D) start poses for a person whose blob is centred at ``centroid`` (3,) metres:
-    standing and (for models with legs) sitting, at every heading of INIT_HEADINGS, the
-    pelvis above the centroid."""
+    standing and (for models with legs) sitting, at every heading of ``headings``
+    (radians), the pelvis above the centroid."""
     poses = []
     postures = [procedural.standing_pose((0.0, 0.0), 0.0, model.dims)]
     if any("knee" in n for n in model.dof_names):
@@ -343,7 +371,7 @@ def start_candidates(model: BodyModel, centroid: np.ndarray) -> np.ndarray:
         postures.append(procedural.sit_down(standing, SEAT_SHARE * model.dims.height, dims=model.dims)[-1])
     for posture in postures:
         fitted = pose_from_joints(model, procedural.joints_from_pose(posture[None], model.dims)[0])
-        for heading in INIT_HEADINGS:
+        for heading in headings:
             pose = fitted.copy()
             pose[model.dof_names.index("heading")] = heading
             poses.append(pose)
@@ -399,7 +427,9 @@ class Tracker:
         """Take one frame: camera name -> (H, W) float32 depth, metres (0 = no measurement).
 
         Returns {track id: PersonEstimate} for every person tracked in this frame (seen,
-        or kept through a short disappearance: then every joint has visible False).
+        or kept through a short disappearance: then every joint has visible False). A
+        person's track id is the id of the blob track that started it; it stays when the
+        person comes back as another blob track (:meth:`_rejoin`).
         """
         self.frame += 1
         clock = time.perf_counter()
@@ -408,11 +438,13 @@ class Tracker:
         labels, blobs = blobs_from_mask(self.grid.moving_mask(), self.spec)
         seen = self.blobs.update(blobs)
         states = self.blobs.states
-        for tid in [t for t in self.people if t not in states]:
-            del self.people[tid]  # its blob has been gone for longer than the gap
-        self._pending = {t: p for t, p in self._pending.items() if t in seen}
+        for pid in [p for p, person in self.people.items() if person.blob not in states]:
+            del self.people[pid]  # its blob has been gone for longer than the gap
+        self._rejoin(seen, states)
+        owner = {person.blob: pid for pid, person in self.people.items()}
+        self._pending = {t: p for t, p in self._pending.items() if t in seen and t not in owner}
         clock = self._tick("blobs", clock)
-        bodies = {t: self.people[t].body_distance() for t in seen if t in self.people}
+        bodies = {t: self.people[owner[t]].body_distance() for t in seen if t in owner}
         bodies |= predicted_from_tracks(states, self._previous, self.fps, ids=[t for t in seen if t not in bodies])
         observations, assigned = observations_from_depth(
             depths, self.cameras, self.spec, labels, seen, states=self.grid.states,
@@ -421,20 +453,35 @@ class Tracker:
         clock = self._tick("observations", clock)
         out = {}
         for tid in seen:
-            person = self.people.get(tid)
-            if person is None:
-                person = self._start(tid, observations[tid], depths, assigned, seen[tid])
-                if person is None:
-                    continue
-                out[tid] = person.estimate(True)
+            if tid in owner:
+                pid = owner[tid]
+                out[pid] = self._step(tid, self.people[pid], observations[tid], depths, assigned, states[tid].centroid)
             else:
-                out[tid] = self._step(tid, person, observations[tid], depths, assigned, states[tid].centroid)
-        for tid, person in self.people.items():
-            if tid not in seen:  # gone (behind something): kept, not estimated
+                person = self._start(tid, observations[tid], depths, assigned, seen[tid])
+                if person is not None:
+                    out[tid] = person.estimate(True)
+        for pid, person in self.people.items():
+            if pid not in out:  # gone (behind something): kept, not estimated
                 person.carry()
-                out[tid] = person.estimate(False)
+                out[pid] = person.estimate(False)
         self._tick("pose", clock)
         return dict(sorted(out.items()))
+
+    def _rejoin(self, seen, states) -> None:
+        """Give a new blob track to the nearest lost person (gone or suspended, whose own blob
+        is not seen) whose carried pelvis is within REJOIN_M of the blob's centroid: a person
+        coming out from behind a cabinet often comes back as a new blob track, because the
+        blob's centroid stalls at the cabinet's edge while they disappear, so the blob
+        tracker's prediction falls short of where they reappear."""
+        owned = {person.blob for person in self.people.values()}
+        lost = {pid: person for pid, person in self.people.items() if person.lost and person.blob not in seen}
+        for tid in seen:
+            if tid in owned or tid in self._pending or not lost or states[tid].age > 0:
+                continue
+            pid, gap = min(((pid, float(np.hypot(*(p.pose[:2] - states[tid].centroid[:2])))) for pid, p in lost.items()),
+                           key=lambda item: item[1])
+            if gap < REJOIN_M:
+                lost.pop(pid).blob = tid
 
     def _hold(self) -> np.ndarray | None:
         """(nx, ny, nz) bool, the cells within the grid's hold margin of the bodies of the
@@ -463,7 +510,7 @@ class Tracker:
         """A new person from its blob, or None while the blob has not been person-like for
         INIT_FRAMES frames."""
         points = observation.points
-        if blob.top < MIN_INIT_TOP or len(points) < MIN_INIT_POINTS:
+        if blob.top < MIN_INIT_TOP or len(points) < MIN_INIT_POINTS or self._at_border(observation):
             self._pending.pop(tid, None)
             return None
         pending = self._pending.setdefault(tid, [])
@@ -477,7 +524,9 @@ class Tracker:
         likelihood_obs = observation_from_views(views, self.method.max_points)
         problem = standing.problem
         problem.set_observation(likelihood_obs)
-        candidates = start_candidates(standing.model, np.mean(points, axis=0))
+        centre = np.mean(points, axis=0)
+        headings = start_headings(self.blobs.states[tid].velocity, centre, self.cameras[0])
+        candidates = start_candidates(standing.model, centre, headings)
         spread = self._spread(standing.model)
         samples = np.repeat(candidates, INIT_SAMPLES, axis=0)
         samples += rng.standard_normal(samples.shape) * spread
@@ -487,9 +536,23 @@ class Tracker:
         for _ in range(INIT_STEPS):
             best = standing.estimator.step(likelihood_obs)
         standing.centroid = np.asarray(blob.centroid, float)
+        standing.blob = tid
         standing.settle(best)
         self.people[tid] = standing
         return standing
+
+    def _at_border(self, observation) -> bool:
+        """Whether the person's pixels touch the left, right or top edge of a camera's image
+        (within BORDER_PX): not fully in view, so its points would misjudge its size. (The
+        bottom edge is allowed: a camera may cut the feet of a person who is near it.)"""
+        for camera in self.cameras:
+            pixels = observation.pixels[camera.name]
+            if len(pixels) == 0:
+                continue
+            v, u = np.divmod(pixels, camera.width)
+            if u.min() < BORDER_PX or u.max() >= camera.width - BORDER_PX or v.min() < BORDER_PX:
+                return True
+        return False
 
     @staticmethod
     def _spread(model: BodyModel) -> np.ndarray:

@@ -264,9 +264,11 @@ def _walk_behind_couch(rng, use_mocap, sensor):
 
 
 def _enter_exit_occlusion(rng, use_mocap, sensor):
+    # walks in, behind the cabinet, turns inside the view (|x| < 1.75 m at y = 3.2), back
+    # behind it, and waves: the same person throughout (leaving the view would end the track)
     m = _Motion(use_mocap, (-2.4, 3.2), 0.0, _dims(rng))
-    m.procedural(lambda b: b.walk([(2.3, 3.2)], speed=1.0).turn(math.pi).stand(0.5)
-                 .walk([(-2.3, 3.2)], speed=1.0).turn(FACING_CAMERA))
+    m.procedural(lambda b: b.walk([(1.5, 3.2)], speed=1.0).turn(math.pi).stand(0.5)
+                 .walk([(-1.5, 3.2)], speed=1.0).turn(FACING_CAMERA))
     m.clip_or("dataset-2_wave-left-hand_active_001", lambda b: b.wave("left", 2.0, 3))
     cams, noise = _front(sensor)
     static = concat([_front_room(), cabinet((0.0, 2.4), heading=FACING_CAMERA, width=1.1, height=1.9)])
@@ -413,7 +415,7 @@ SCENARIOS: dict[str, ScenarioEntry] = {
     "walk_behind_couch": ScenarioEntry(
         "walks behind a couch that hides the legs, back and forth, then waves", _walk_behind_couch),
     "enter_exit_occlusion": ScenarioEntry(
-        "walks behind a tall cabinet twice: most of the body hidden for 1-2 s each time", _enter_exit_occlusion),
+        "walks behind a tall cabinet and back, turning in view: most of the body hidden for 1-2 s each time", _enter_exit_occlusion),
     "gesture_behind_chair": ScenarioEntry(
         "walks in and gestures standing behind a chair whose back hides hips and thighs", _gesture_behind_chair),
     "moved_chair": ScenarioEntry(
