@@ -135,6 +135,9 @@ CARRY_SPEED = 0.067
 MAX_ANCHOR = 0.25
 #: A person starting faster than this walks: it starts facing the way it walks, m/s.
 WALKING_SPEED = 0.3
+#: The upper-body model sees only the points above this share of the person's stature
+#: (the hips are at about 0.53).
+UPPER_CUT = 0.5
 #: A new blob track within this distance of a lost person's carried pelvis is that
 #: person's, metres (horizontal).
 REJOIN_M = 1.0
@@ -498,11 +501,17 @@ class Tracker:
         self.seconds[stage] += now - start
         return now
 
-    def _views(self, pixels: Mapping[str, np.ndarray], depths) -> list[View]:
+    def _views(self, observation, depths, model: BodyModel) -> list[View]:
+        """The likelihood's views of a person: its pixels in each camera, for the upper-body
+        model only those above UPPER_CUT of its stature (as the second paper thresholds its
+        top-view images: the model has no legs, and leg points pull its hanging arms down)."""
         views = []
         for camera in self.cameras:
+            pixels = observation.pixels[camera.name]
+            if model.name == "upper":
+                pixels = pixels[observation.camera_points[camera.name][:, 2] >= UPPER_CUT * model.dims.height]
             mask = np.zeros(camera.height * camera.width, bool)
-            mask[pixels[camera.name]] = True
+            mask[pixels] = True
             views.append(View(camera, depths[camera.name], mask.reshape(camera.height, camera.width)))
         return views
 
@@ -520,7 +529,7 @@ class Tracker:
         size = dims_from_observation(np.concatenate(self._pending.pop(tid)))
         rng = np.random.default_rng(self._seeds.spawn(1)[0])
         standing = _Person(body_model(self.model_name, size.dims, size.girth), self.method, self.fps, rng)
-        views = self._views(observation.pixels, depths)
+        views = self._views(observation, depths, standing.model)
         likelihood_obs = observation_from_views(views, self.method.max_points)
         problem = standing.problem
         problem.set_observation(likelihood_obs)
@@ -589,7 +598,7 @@ class Tracker:
             person.problem.hidden_parts = ~person.part_visible
         if not any(len(p) for p in observation.pixels.values()):
             return person.estimate(False)
-        views = self._views(observation.pixels, depths)
+        views = self._views(observation, depths, person.model)
         pose = person.estimator.step(observation_from_views(views, self.method.max_points),
                                      active=active, diffusion_scale=scale)
         if person.occlusion is not None:
