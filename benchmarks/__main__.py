@@ -14,11 +14,12 @@ from benchmarks import (
     bench_grid,
     bench_likelihood,
     bench_render,
+    bench_speed,
     bench_tracking,
     format_table,
 )
 
-BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking]
+BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed]
 
 
 def machine() -> str:

@@ -1,0 +1,57 @@
+"""Frames per second of the whole tracker (`occupose track`'s loop) for 1, 2 and 3 people.
+
+Method ``ours`` (apf+ps, 200 particles x 5 layers, occlusion handling), one 640x480
+Kinect v1, 5 cm grid, procedural motion (the same scenes with or without the shared
+data). The frames are rendered first; the clock covers ``Tracker.update`` only, the first
+frame (start-up: numba's compiled code loaded from the cache) excluded, as in
+``summary.json``. Three people: ``two_people_crossing`` with the walker of
+``no_occlusion`` added between them.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+
+import numpy as np
+
+from occupose.synth.generate import frames
+from occupose.synth.scenarios import build_scenario
+from occupose.tracker import Tracker, track_frames
+
+TITLE = "Tracker speed: frames/s of `occupose track` (ours), start-up excluded, and ms per frame per stage"
+
+NUM_FRAMES = 150
+
+
+def _three_people():
+    scene = build_scenario("two_people_crossing", use_mocap=False)
+    walker = build_scenario("no_occlusion", use_mocap=False).people[0]
+    joints = walker.joints[: scene.num_frames].copy()
+    joints[..., 1] += 3.0 - np.nanmean(joints[:, :, 1])  # walks between the other two
+    return replace(scene, name="three_people", people=scene.people + (replace(walker, joints=joints),))
+
+
+def _scenes():
+    yield "sit_behind_table", build_scenario("sit_behind_table", use_mocap=False)
+    yield "two_people_crossing", build_scenario("two_people_crossing", use_mocap=False)
+    yield "three_people", _three_people()
+
+
+def run() -> list[dict]:
+    rows = []
+    for name, scene in _scenes():
+        rendered = list(frames(scene, seed=0, num_frames=NUM_FRAMES))
+        tracker = Tracker(scene.cameras, scene.fps, "ours", seed=0)
+        result = track_frames(tracker, rendered, NUM_FRAMES)
+        per_frame = {stage: 1e3 * seconds / NUM_FRAMES for stage, seconds in result.seconds.items()
+                     if stage not in ("total", "startup")}
+        tracked = [np.isfinite(j[:, 0, 0]) for j, _ in result.tracks.values()]
+        rows.append({
+            "scene": name, "people in scene": len(scene.people),
+            "people tracked (last frame)": int(sum(t[-1] for t in tracked)),
+            "frames/s": result.fps, "grid ms": per_frame["grid"], "blobs ms": per_frame["blobs"],
+            "observations ms": per_frame["observations"], "pose ms": per_frame["pose"],
+            "load": os.getloadavg()[0],
+        })
+    return rows
