@@ -66,12 +66,17 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
     sigma_lut (C, L) float64 metres; lut_step float metres; half_extents (C,) float64 metres
     tail_width, p_occ, p_free : floats of the observation function (tail width in noise stds)
     transition : (3, 3) float64, row = previous state, column = next state
-    held : (3, 3) float64, the transition matrix of held cells; hold : (N,) bool or (0,) bool
+    held : (3, 3) float64, the transition matrix of held cells (only its M row may differ from
+        ``transition``); hold : (N,) bool or (0,) bool
     flush : float, posterior probabilities below it are set to 0 (no subnormal floats)
     probabilities : (N, 3) float32 in/out; states, visibility : (N,) uint8 out
     """
     num_cameras = rotations.shape[0]
     use_hold = hold.size > 0
+    t_oo, t_om, t_oe = transition[0, 0], transition[0, 1], transition[0, 2]
+    t_mo, t_mm, t_me = transition[1, 0], transition[1, 1], transition[1, 2]
+    t_eo, t_em, t_ee = transition[2, 0], transition[2, 1], transition[2, 2]
+    h_mo, h_mm, h_me = held[1, 0], held[1, 1], held[1, 2]
     lut_last = sigma_lut.shape[1] - 1
     lut_scale = 1.0 / lut_step
     for i in numba.prange(nx):
@@ -116,15 +121,15 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                 q_o = probabilities[n, 0]
                 q_m = probabilities[n, 1]
                 q_e = probabilities[n, 2]
-                a = transition
+                m_o, m_m, m_e = t_mo, t_mm, t_me  # the M row: the only one a hold changes
                 if use_hold and hold[n]:
-                    a = held
+                    m_o, m_m, m_e = h_mo, h_mm, h_me
                     if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
                         q_m += q_o
                         q_o = 0.0
-                r_o = (q_o * a[0, 0] + q_m * a[1, 0] + q_e * a[2, 0]) * b_occupied
-                r_m = (q_o * a[0, 1] + q_m * a[1, 1] + q_e * a[2, 1]) * b_occupied
-                r_e = (q_o * a[0, 2] + q_m * a[1, 2] + q_e * a[2, 2]) * b_empty
+                r_o = (q_o * t_oo + q_m * m_o + q_e * t_eo) * b_occupied
+                r_m = (q_o * t_om + q_m * m_m + q_e * t_em) * b_occupied
+                r_e = (q_o * t_oe + q_m * m_e + q_e * t_ee) * b_empty
                 scale = 1.0 / (r_o + r_m + r_e)
                 r_o *= scale
                 r_m *= scale
