@@ -9,6 +9,7 @@ from click.testing import CliRunner
 from occupose.body import body_model, capsules_from_poses, joints_from_poses, standing_pose
 from occupose.camera import Camera, look_at, raw_depth_from_metres
 from occupose.cli import main
+from occupose.grid.observation import Observation as GridObservation
 from occupose.joints import JOINT_INDEX, JOINTS
 from occupose.metrics import frame_errors, joint_errors, read_tracks_csv
 from occupose.recording import Recording, RecordingWriter
@@ -218,3 +219,29 @@ def test_track_command_bad_input(tmp_path):
     result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o")])
     assert result.exit_code == 0 and "nobody was tracked" in result.output
     assert Recording(rec).num_frames == 1
+
+
+def test_an_empty_recording_is_refused_clearly(tmp_path):
+    rec = tmp_path / "empty"
+    with RecordingWriter(rec, [_camera()], 30.0):
+        pass
+    result = CliRunner().invoke(main, ["track", str(rec), "--out", str(tmp_path / "o")])
+    assert result.exit_code != 0 and "the recording has no frames, nothing to track" in result.output
+
+
+def test_a_person_cut_by_the_image_edge_does_not_start():
+    """A person not fully in view (pixels at the left, right or top edge) is not started: its
+    points would misjudge its size; the bottom edge (feet cut near the camera) is allowed."""
+    camera = _camera()
+    tracker = Tracker([camera], 30.0)
+
+    def observation(rows, cols):
+        v, u = np.meshgrid(np.arange(*rows), np.arange(*cols), indexing="ij")
+        pixels = np.sort((v * camera.width + u).reshape(-1))
+        return GridObservation(1, {"cam": pixels}, {"cam": np.zeros((pixels.size, 3))})
+
+    assert not tracker._at_border(observation((20, 110), (60, 90)))
+    assert not tracker._at_border(observation((20, 120), (60, 90)))  # feet at the bottom edge
+    assert tracker._at_border(observation((20, 110), (0, 30)))  # left edge
+    assert tracker._at_border(observation((20, 110), (140, 160)))  # right edge
+    assert tracker._at_border(observation((0, 60), (60, 90)))  # top edge
