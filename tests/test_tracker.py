@@ -59,6 +59,18 @@ def test_tracks_the_walk_from_its_blob_without_a_start_pose(walk):
     assert result.fps > 0 and set(result.seconds) >= {"grid", "blobs", "observations", "pose", "total"}
 
 
+def test_overlapping_the_grid_with_the_pose_stage_tracks_alike(walk):
+    """The grid update of frame t + 1 runs during stage 3 of frame t (its hold mask from the
+    bodies of frame t - 1): the same person, tracked as well."""
+    scenario, rendered = walk
+    results = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0), rendered[:40], 40, overlap=o)
+               for o in (False, True)]
+    assert [list(r.tracks) for r in results] == [[1], [1]]
+    gt = np.stack([f.joints[0] for f in rendered[:40]])
+    errors = [np.nanmean(frame_errors(joint_errors(gt, r.tracks[1][0]))) for r in results]
+    assert abs(errors[0] - errors[1]) < 0.01, errors
+
+
 def test_same_seed_same_tracks(walk):
     scenario, rendered = walk
     runs = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=s), rendered[:20], 20).tracks

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -425,18 +426,36 @@ class Tracker:
         self.frame = -1
         self.seconds = {"grid": 0.0, "blobs": 0.0, "observations": 0.0, "pose": 0.0}
         self.last_assigned: dict[str, np.ndarray] = {}
+        self._pool: ThreadPoolExecutor | None = None  # the grid's thread when updates overlap
+        self._grid_job = None
 
-    def update(self, depths: Mapping[str, np.ndarray]) -> dict[int, PersonEstimate]:
+    def close(self) -> None:
+        """Stop the grid's thread (when :meth:`update` was given ``upcoming`` frames)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+
+    def update(self, depths: Mapping[str, np.ndarray], upcoming: Mapping[str, np.ndarray] | None = None
+               ) -> dict[int, PersonEstimate]:
         """Take one frame: camera name -> (H, W) float32 depth, metres (0 = no measurement).
 
         Returns {track id: PersonEstimate} for every person tracked in this frame (seen,
         or kept through a short disappearance: then every joint has visible False). A
         person's track id is the id of the blob track that started it; it stays when the
         person comes back as another blob track (:meth:`_rejoin`).
+
+        upcoming : the next frame's depths, or None. Given, the grid takes it on a second
+        thread while stage 3 works on this frame (the paper's IV-B: the grid's kernel
+        releases the GIL), and the next call must pass exactly that frame; its hold mask
+        then comes from the bodies of the frame before this one.
         """
         self.frame += 1
         clock = time.perf_counter()
-        self.grid.update(depths, hold=self._hold() if self.hold_people else None)
+        if self._grid_job is not None:  # this frame's grid update ran during the last stage 3
+            self._grid_job.result()
+            self._grid_job = None
+        else:
+            self.grid.update(depths, hold=self._hold() if self.hold_people else None)
         clock = self._tick("grid", clock)
         labels, blobs = blobs_from_mask(self.grid.moving_mask(), self.spec)
         seen = self.blobs.update(blobs)
@@ -453,6 +472,11 @@ class Tracker:
             depths, self.cameras, self.spec, labels, seen, states=self.grid.states,
             centers={t: states[t].centroid for t in seen}, predicted=bodies)
         self._previous, self.last_assigned = observations, assigned
+        if upcoming is not None:
+            if self._pool is None:
+                self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="occupose-grid")
+            hold = self._hold() if self.hold_people else None
+            self._grid_job = self._pool.submit(self.grid.update, upcoming, hold)
         clock = self._tick("observations", clock)
         out = {}
         for tid in seen:
@@ -633,17 +657,23 @@ class TrackingResult:
     settings: dict = field(default_factory=dict)
 
 
-def track_frames(tracker: Tracker, frames, num_frames: int, progress=None) -> TrackingResult:
+def track_frames(tracker: Tracker, frames, num_frames: int, progress=None, overlap: bool = False) -> TrackingResult:
     """Run ``tracker`` over ``frames`` (an iterable of objects with ``.index`` and ``.depth``,
     e.g. ``Recording.frames()``), ``num_frames`` of them. ``progress`` : callable(n) called
-    after each frame, or None."""
+    after each frame, or None. ``overlap`` : update the grid with the next frame while the
+    pose stage works on the current one (:meth:`Tracker.update`'s ``upcoming``)."""
     joints = {}
     visible = {}
     startup = 0.0
     total = 0.0
-    for n, frame in enumerate(frames):
+    frames = iter(frames)
+    upcoming = next(frames, None)
+    n = -1
+    while upcoming is not None:
+        n += 1
+        frame, upcoming = upcoming, next(frames, None)
         start = time.perf_counter()
-        estimates = tracker.update(frame.depth)
+        estimates = tracker.update(frame.depth, upcoming.depth if overlap and upcoming is not None else None)
         spent = time.perf_counter() - start
         if n == 0:
             startup = spent
@@ -657,20 +687,23 @@ def track_frames(tracker: Tracker, frames, num_frames: int, progress=None) -> Tr
             visible[tid][frame.index] = est.visible
         if progress is not None:
             progress(1)
+    tracker.close()
     seconds = dict(tracker.seconds, total=total, startup=startup)
     fps = (num_frames - 1) / total if num_frames > 1 and total > 0 else 0.0
     return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, seconds, fps, num_frames)
 
 
-def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=None, **settings) -> TrackingResult:
+def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=None, overlap: bool = True,
+                    **settings) -> TrackingResult:
     """Track every person of an open :class:`occupose.recording.Recording`.
 
     method, seed, settings : as :class:`Tracker` (settings: Method fields, ``cell``,
-    ``grid_options``, ``max_gap_s``); progress : callable(n) after each frame, or None.
+    ``grid_options``, ``max_gap_s``); progress : callable(n) after each frame, or None;
+    overlap : as :func:`track_frames` (measured faster: benchmarks/bench_speed.py).
     An empty recording (no frames) gives an empty result.
     """
     tracker = Tracker(recording.cameras, recording.fps, method, seed=seed, **settings)
-    result = track_frames(tracker, recording.frames(), recording.num_frames, progress)
+    result = track_frames(tracker, recording.frames(), recording.num_frames, progress, overlap=overlap)
     result.settings = {"method": method, "seed": seed,
                        **{k: getattr(tracker.method, k) for k in Method.__dataclass_fields__},
                        "model": tracker.model_name}
