@@ -16,11 +16,17 @@ A frame:
 3. every tracked blob's pixels go to its person; where people touch, each pixel goes
    to the nearest predicted body (exclusion principle; a new person's body is made of
    its previous points, see :func:`occupose.grid.observation.predicted_from_tracks`);
-4. per person: a new track is initialised once its blob is tall enough (body size from
-   its points, a search over heading and a standing or sitting start); a known one first
-   runs the occlusion check (its previous estimate moved to the blob's new centre of
-   mass), then the filter on the visible subtree;
-5. tracks whose blob has been gone for longer than the blob tracker's gap end.
+4. per person: a new track starts once its blob has been tall enough and fully in view
+   for a few frames (body size from their points, a search over headings facing where
+   it walks or the camera, standing or sitting); a known one first runs the occlusion
+   check (its previous estimate moved to the blob's new centre of mass), then the filter
+   on the visible subtree; hidden legs are placed with their feet on the floor;
+5. a person whose torso is hidden is kept (suspended) and moved with its blob; one whose
+   blob is gone is kept and carried at its last velocity; either is placed back on its
+   blob when seen again (a new blob track near it is its); it ends when its blob has been
+   gone for longer than ``max_gap_s``.
+
+With ``upcoming`` frames, step 1 of the next frame runs on a second thread during step 4.
 
 Methods (:data:`METHODS`) are named presets of filter, budget and occlusion handling;
 every setting can be overridden.
@@ -90,9 +96,9 @@ class Method:
 #: spread over the 3 partitioned-sampling stages, 2 on the root, 1 on the head and arms,
 #: 2 on the legs: 1000 likelihood evaluations per frame; on sit_behind_table, 300 frames,
 #: this split gave 8.3 cm against 11.0 cm for 3, 1, 1 and 19.2 cm for 1, 1, 3) with
-#: occlusion handling; ``apf``
-#: and ``ps`` its baselines (2000 evaluations each, no occlusion handling); ``part-based``
-#: the second paper's upper-body filter. All use the same likelihood.
+#: occlusion handling; ``apf`` and ``ps`` its baselines (2000 evaluations each, no
+#: occlusion handling); ``part-based`` the second paper's upper-body filter (1000
+#: evaluations). All use the same likelihood.
 METHODS: dict[str, Method] = {
     "ours": Method("apf+ps", 200, (2, 1, 2), occlusion=True),
     "apf": Method("apf", 200, 10),
