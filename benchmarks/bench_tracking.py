@@ -28,12 +28,11 @@ from pathlib import Path
 import numpy as np
 
 from occupose.body import body_model, pose_from_joints
-from occupose.joints import JOINT_INDEX, PART_INDEX
-from occupose.likelihood import View, observation_from_views
+from occupose.joints import JOINT_INDEX
 from occupose.metrics import frame_errors, is_fail, joint_errors
 from occupose.paths import mocap_dir
 from occupose.pose import PoseEstimator, PoseProblem
-from occupose.synth.generate import frames
+from occupose.synth.generate import person_observations
 from occupose.synth.motion import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
@@ -50,23 +49,12 @@ NUM_FRAMES = 120
 SEEDS = (0, 1)
 MAX_POINTS = 1000
 ARMS = [JOINT_INDEX[name] for name in ("left_elbow", "left_wrist", "right_elbow", "right_wrist")]
-UPPER_BODY_PARTS = [PART_INDEX[name] for name in (
-    "head", "chest", "pelvis", "left_upper_arm", "left_forearm", "left_hand",
-    "right_upper_arm", "right_forearm", "right_hand")]
 
 
 def _scene(name: str, upper_body_only: bool):
     """(scenario, ground-truth joints (T, 15, 3) metres, [Observation] * T) of person 1."""
     scenario = build_scenario(name, use_mocap=mocap_dir() is not None)
-    camera = scenario.cameras[0]
-    observations = []
-    for frame in frames(scenario, seed=0, num_frames=NUM_FRAMES):
-        rendered = frame.rendered[camera.name]
-        mask = rendered.person == 1
-        if upper_body_only:
-            mask &= np.isin(rendered.part, UPPER_BODY_PARTS)
-        observations.append(observation_from_views([View(camera, frame.depth[camera.name], mask)],
-                                                   max_points=MAX_POINTS))
+    observations = person_observations(scenario, NUM_FRAMES, upper_body_only=upper_body_only, max_points=MAX_POINTS)
     return scenario, scenario.people[0].joints[:NUM_FRAMES], observations
 
 

@@ -27,37 +27,22 @@ import numpy as np
 import pytest
 
 from occupose.body import body_model, joints_from_poses, pose_from_joints, standing_pose
-from occupose.joints import JOINT_INDEX, PART_INDEX
+from occupose.joints import JOINT_INDEX
 from occupose.likelihood import View, observation_from_views
 from occupose.metrics import frame_errors, is_fail, joint_errors, table_row
 from occupose.pose import PoseEstimator, PoseProblem, default_stages
-from occupose.synth.generate import frames
+from occupose.synth.generate import frames, person_observations
 from occupose.synth.motion import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
 NUM_FRAMES = 90  # 3 s at 30 fps: the FAIL rule's 2 s window after its 1 s grace period
 MAX_POINTS = 1000
 ARMS = [JOINT_INDEX[name] for name in ("left_elbow", "left_wrist", "right_elbow", "right_wrist")]
-#: Renderer part labels of the upper body (head, chest, pelvis, arms and hands): the second
-#: paper thresholds its images to these pixels for its upper-body model.
-UPPER_BODY_PARTS = [PART_INDEX[name] for name in (
-    "head", "chest", "pelvis", "left_upper_arm", "left_forearm", "left_hand",
-    "right_upper_arm", "right_forearm", "right_hand")]
-
-
 def _scene(name: str, upper_body_only: bool = False):
     """(ground-truth joints (T, 15, 3) metres, [Observation] * T) of person 1 on procedural motion."""
     scenario = build_scenario(name, use_mocap=False)
-    camera = scenario.cameras[0]
-    observations = []
-    for frame in frames(scenario, seed=0, num_frames=NUM_FRAMES):
-        rendered = frame.rendered[camera.name]
-        mask = rendered.person == 1
-        if upper_body_only:
-            mask &= np.isin(rendered.part, UPPER_BODY_PARTS)
-        observations.append(observation_from_views([View(camera, frame.depth[camera.name], mask)],
-                                                   max_points=MAX_POINTS))
-    return scenario.people[0].joints[:NUM_FRAMES], observations
+    return scenario.people[0].joints[:NUM_FRAMES], person_observations(
+        scenario, NUM_FRAMES, upper_body_only=upper_body_only, max_points=MAX_POINTS)
 
 
 @pytest.fixture(scope="module")

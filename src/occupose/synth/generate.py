@@ -135,3 +135,32 @@ def write_scenario(scenario: Scenario, out: str | Path, seed: int = 0, num_frame
                 progress(1)
         writer.write_groundtruth(gt, vis, person_ids=list(range(1, num_people + 1)))
     return out
+
+
+#: Renderer part labels of the upper body (head, chest, pelvis, arms and hands): the second
+#: paper thresholds its top-view images to these pixels for its upper-body model.
+UPPER_BODY_PARTS = tuple(PARTS.index(name) for name in (
+    "head", "chest", "pelvis", "left_upper_arm", "left_forearm", "left_hand",
+    "right_upper_arm", "right_forearm", "right_hand"))
+
+
+def person_observations(scenario: Scenario, num_frames: int, *, person: int = 1, upper_body_only: bool = False,
+                        max_points: int = 1000, seed: int = 0) -> list:
+    """One person's likelihood observations straight from the renderer (no stages 1-2).
+
+    For testing and benchmarking stage 3 alone: each of the first ``num_frames`` frames
+    gives an :class:`occupose.likelihood.Observation` of the first camera, the person's
+    pixels taken from the renderer's person-id image (person ids from 1), with
+    ``upper_body_only`` only those of :data:`UPPER_BODY_PARTS`; ``max_points`` points.
+    """
+    from occupose.likelihood import View, observation_from_views
+
+    camera = scenario.cameras[0]
+    out = []
+    for frame in frames(scenario, seed=seed, num_frames=num_frames):
+        rendered = frame.rendered[camera.name]
+        mask = rendered.person == person
+        if upper_body_only:
+            mask &= np.isin(rendered.part, UPPER_BODY_PARTS)
+        out.append(observation_from_views([View(camera, frame.depth[camera.name], mask)], max_points=max_points))
+    return out
