@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
-from occupose.filters import make_filter
+from occupose.filters import apply_limits, make_filter
 from occupose.likelihood import Observation, make_likelihood
 
 
@@ -145,12 +145,14 @@ class PoseEstimator:
 
     def shift(self, offset: np.ndarray) -> None:
         """Move every particle, the estimate and the velocity memory by ``offset`` (D,), e.g.
-        the root's x, y to where a person reappeared (no velocity is inferred from the jump)."""
+        the root's x, y to where a person reappeared (no velocity is inferred from the jump),
+        then bring them inside the limits (a heading turned by pi wraps)."""
         offset = np.asarray(offset, float)
         if offset.shape != (self.problem.num_dofs,):
             raise ValueError(f"offset must have shape ({self.problem.num_dofs},), got {offset.shape}")
-        self.filter.particles = self.filter.particles + offset
-        self.filter.estimate = self.filter.estimate + offset
+        limits, angular = self.problem.limits, self.problem.angular
+        self.filter.particles = apply_limits(self.filter.particles + offset, limits, angular)
+        self.filter.estimate = apply_limits((self.filter.estimate + offset)[None], limits, angular)[0]
         self._previous = self.filter.estimate.copy()
 
     def step(self, observation: Observation, *, active: np.ndarray | None = None,

@@ -140,8 +140,11 @@ CARRY_SPEED = 0.067
 #: Largest horizontal offset between the pelvis and its blob's centroid kept for placing
 #: a person that is back, metres.
 MAX_ANCHOR = 0.25
-#: A person starting faster than this walks: it starts facing the way it walks, m/s.
+#: A person faster than this walks, m/s: it starts facing the way it walks, and one who
+#: walks more than BACKWARDS (radians) away from the way it faces is turned round.
 WALKING_SPEED = 0.3
+BACKWARDS = np.deg2rad(135.0)
+START_CHECK_S = 2.0
 #: The upper-body model sees only the points above this share of the person's stature
 #: (the hips are at about 0.53).
 UPPER_CUT = 0.5
@@ -312,6 +315,9 @@ class _Person:
         self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
         self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
         self.part_visible = np.ones(model.num_parts, bool)
+        self.fps = fps
+        self.since_turn = 0  # estimates since the last turn round (face_the_way_walked)
+        self.estimates = 0  # estimates since the start
 
     def settle(self, pose: np.ndarray) -> None:
         """Take a new estimate (D,)."""
@@ -319,6 +325,31 @@ class _Person:
         anchor = pose[:2] - self.centroid[:2]  # a partly hidden blob's centroid is off: clipped
         self.anchor = anchor * min(1.0, MAX_ANCHOR / max(float(np.hypot(*anchor)), 1e-12))
         self.path = (self.path + [pose[:2].copy()])[-CARRY_FRAMES:]
+
+    def face_the_way_walked(self) -> None:
+        """In a person's first START_CHECK_S seconds, turn the whole estimate round (heading +
+        pi) when the person has walked faster than WALKING_SPEED over the last CARRY_FRAMES
+        estimates in a direction more than BACKWARDS from the way it faces, at most once
+        per CARRY_FRAMES. A body of round cones fits its points about as well facing either
+        way, and the blob's velocity a person starts with can be off (the grid extracts a
+        body over its first frames, and the centroid moves with it), so a person may start
+        facing backwards. Only at the start: later, a person who turns round to sit down
+        still shows the way it came in its recent path."""
+        self.since_turn += 1
+        self.estimates += 1
+        if (len(self.path) < CARRY_FRAMES or self.since_turn < CARRY_FRAMES
+                or self.estimates > START_CHECK_S * self.fps):
+            return
+        velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps
+        heading = self.model.dof_names.index("heading")
+        facing = self.pose[heading]
+        off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
+        if np.hypot(*velocity) > WALKING_SPEED and abs(off) > BACKWARDS:
+            turn = np.zeros(self.model.num_dofs)
+            turn[heading] = np.pi
+            self.estimator.shift(turn)
+            self.pose = self.estimator.filter.estimate.copy()
+            self.since_turn = 0
 
     def carry(self) -> None:
         """A frame without an estimate (gone or suspended): the pose walks on at the pelvis's
@@ -641,6 +672,7 @@ class Tracker:
                 pose = planted_legs(person.model, pose, hidden_legs)
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
         person.settle(pose)
+        person.face_the_way_walked()
         return person.estimate(True)
 
 
