@@ -251,10 +251,12 @@ def _two_cameras_occlusion(rng, use_mocap, sensor):
 
 
 def _walk_behind_couch(rng, use_mocap, sensor):
+    # back and forth behind the couch, turning inside the view (|x| < 1.8 m at y = 3.3):
+    # the same person throughout (leaving the view would end the track)
     m = _Motion(use_mocap, (-2.4, 3.3), 0.0, _dims(rng))
-    _walk(m, 0.0, 3.6)
+    _walk(m, 0.0, 2.9)
     m.procedural(lambda b: b.turn(math.pi / 2).stand(0.3))
-    _walk(m, math.pi, 3.6, clip="dataset-1_walk_happy_001")
+    _walk(m, math.pi, 1.9, clip="dataset-1_walk_happy_001")
     m.procedural(lambda b: b.turn(FACING_CAMERA))
     m.clip_or("dataset-1_bye_normal_001", lambda b: b.wave("right", 2.5, 3))
     cams, noise = _front(sensor)
