@@ -12,6 +12,7 @@ from occupose.cli import main
 from occupose.grid.observation import Observation as GridObservation
 from occupose.joints import JOINT_INDEX, JOINTS
 from occupose.metrics import frame_errors, joint_errors, read_tracks_csv
+from occupose.occlusion import hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.recording import Recording, RecordingWriter
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
@@ -19,10 +20,6 @@ from occupose.tracker import (
     INIT_FRAMES,
     METHODS,
     Tracker,
-    _joint_parts,
-    _part_tree,
-    hidden_parts_in_views,
-    planted_legs,
     track_frames,
 )
 
@@ -132,7 +129,7 @@ def test_auto_model_is_upper_for_a_ceiling_camera():
 
 def test_part_tree_of_the_full_model():
     model = body_model("full")
-    parents, dofs = _part_tree(model)
+    parents, dofs = part_tree(model)
     names = model.part_names
     named = {names[k]: (names[p] if p >= 0 else None) for k, p in enumerate(parents)}
     assert named == {"torso": None, "head": "torso", "left_upper_arm": "torso", "left_forearm": "left_upper_arm",
@@ -143,13 +140,13 @@ def test_part_tree_of_the_full_model():
 
 def test_joints_are_visible_when_the_parts_placing_them_are():
     model = body_model("full")
-    parts = {JOINTS[j]: sorted(model.part_names[k] for k in p) for j, p in enumerate(_joint_parts(model))}
+    parts = {JOINTS[j]: sorted(model.part_names[k] for k in p) for j, p in enumerate(joint_parts(model))}
     assert parts["pelvis"] == ["torso"] and parts["left_hip"] == ["torso"]
     assert parts["left_knee"] == ["left_thigh", "torso"]
     assert parts["right_ankle"] == ["right_shin", "right_thigh", "torso"]
     assert parts["head"] == ["head", "torso"]
     upper = body_model("upper")
-    assert [len(p) for p in _joint_parts(upper)][JOINT_INDEX["left_knee"]] == 0  # not reported
+    assert [len(p) for p in joint_parts(upper)][JOINT_INDEX["left_knee"]] == 0  # not reported
 
 
 def test_hidden_parts_behind_a_surface_that_is_not_the_person():

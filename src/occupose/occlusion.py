@@ -15,16 +15,32 @@ A hidden part hides its whole subtree (a hidden thigh hides the shin); a hidden 
 DOFs of visible parts; hidden parts keep their memory configuration relative to their
 parent. A part that becomes visible again gets a wider search for a few frames (its DOFs'
 diffusion multiplied by ``resume_scale`` for ``resume_frames`` frames).
+
+Two tests of which parts are hidden: :func:`hidden_parts` against the grid's cell
+visibility, as in the paper, and :func:`hidden_parts_in_views` against the depth images
+and each pixel's owner, which the tracker uses (the paper's grid test hides parts behind
+the person's own surface). :func:`part_tree` gives a body model's part tree for the state
+machine, :func:`joint_parts` which parts a joint's visibility depends on, and
+:func:`planted_legs` where hidden legs most likely are (feet on the floor).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
+from occupose.body import BodyModel, joints_from_poses
+from occupose.camera import Camera, pixels_from_points
+from occupose.joints import JOINT_INDEX
+
 #: Grid visibility code of a hidden cell (see occupose.grid.occupancy).
 HIDDEN_CELL = 2
+#: Hip flexions and knee bends tried when placing hidden legs (:func:`planted_legs`), radians.
+PLANT_HIP = np.linspace(0.0, 1.8, 19)
+PLANT_KNEE = np.linspace(0.0, 2.2, 23)
+#: A part is hidden behind a measured surface nearer than its sphere by more than this, metres.
+HIDDEN_MARGIN = 0.1
 
 
 def sphere_centres(a: np.ndarray, b: np.ndarray, n: int = 5) -> np.ndarray:
@@ -143,3 +159,115 @@ class OcclusionState:
             if not self.visible[k]:
                 out[dofs] = self.memory[dofs]
         return out
+
+
+def part_tree(model: BodyModel) -> tuple[list[int], list[np.ndarray]]:
+    """Parent part of each part (-1 for the root) and the DOFs that place each part relative
+    to its parent (the model's weight groups), for the occlusion state machine.
+
+    A part's parent is the part owning the DOFs of the nearest ancestor node with DOFs.
+    Raises ValueError for a model whose parts are not in parent-first order.
+    """
+    owner = np.full(model.num_dofs, -1)
+    for k, group in enumerate(model.weight_groups):
+        owner[group.dofs] = k
+    node_part = np.full(len(model.node_names), -1)
+    for d in range(model.num_dofs):
+        node_part[model.dof_node[d]] = owner[d]
+    parents = []
+    for group in model.weight_groups:
+        node = int(model.dof_node[group.dofs].min())
+        parent, up = -1, int(model.parents[node])
+        while up >= 0 and parent < 0:
+            parent, up = int(node_part[up]), int(model.parents[up])
+        parents.append(parent)
+    if any(p >= k for k, p in enumerate(parents)) or parents.count(-1) != 1:
+        raise ValueError(f"body model {model.name!r} has no parent-first part tree (parents {parents})")
+    return parents, [np.asarray(g.dofs) for g in model.weight_groups]
+
+
+def joint_parts(model: BodyModel) -> list[np.ndarray]:
+    """For each canonical joint, the parts whose DOFs place it (empty where the model does
+    not report the joint): a joint is visible when all of them are."""
+    owner = np.full(model.num_dofs, -1)
+    for k, group in enumerate(model.weight_groups):
+        owner[group.dofs] = k
+    out = []
+    for node in model.joint_nodes:
+        if node < 0:
+            out.append(np.zeros(0, int))
+            continue
+        chain, up = [], int(model.parents[node])
+        chain.append(int(node)) if up < 0 else None  # the root is placed by its own DOFs
+        while up >= 0:
+            chain.append(up)
+            up = int(model.parents[up])
+        out.append(np.unique(owner[np.isin(model.dof_node, chain)]))
+    return out
+
+
+def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsule_part: np.ndarray,
+                          num_parts: int, depths: Mapping[str, np.ndarray], owners: Mapping[str, np.ndarray],
+                          cameras: Sequence[Camera], track_id: int, n: int = 5,
+                          margin: float = HIDDEN_MARGIN) -> np.ndarray:
+    """Which parts have more than half of their spheres hidden from every camera.
+
+    A sphere (``n`` per capsule, along its axis) is hidden from a camera when it projects
+    outside the image, or onto a pixel whose measured surface is nearer than the sphere's
+    front (its centre minus the capsule's radius there) by more than ``margin`` and that
+    pixel does not belong to this person (``owners`` is not ``track_id``): the person's
+    own body in front of a part (an arm across the chest) does not hide it, furniture
+    and other people do. A pixel without a measurement hides nothing.
+
+    This is the test of the paper's III-D with the depth images in place of the grid's
+    cell visibility (:func:`occupose.occlusion.hidden_parts`): a sphere on a limb's axis
+    lies a few centimetres behind the person's own measured surface, in a cell the grid
+    calls hidden, so the grid test hides visible parts (the paper notes this for seated
+    legs); the pixel's owner tells the person's own surface from the scene's.
+
+    a, b : (C, 3) capsule ends of one pose, metres, world; radii : (C, 2) metres
+    capsule_part : (C,) part index; depths : camera name -> (H, W) float32 metres
+    owners : camera name -> (H, W) int track id of each pixel (0 = nobody)
+    Returns (num_parts,) bool.
+    """
+    t = (np.arange(n) + 0.5) / n
+    centres = (a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]).reshape(-1, 3)
+    radius = (radii[:, :1] + t[None, :] * (radii[:, 1:] - radii[:, :1])).reshape(-1)
+    hidden = np.ones(len(centres), bool)
+    for camera in cameras:
+        uv, z = pixels_from_points(centres, camera)
+        uv = np.round(np.nan_to_num(uv, nan=-1.0, posinf=-1.0, neginf=-1.0))
+        u, v = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
+        inside = (z > 0) & (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
+        ui, vi = np.where(inside, u, 0), np.where(inside, v, 0)
+        measured = depths[camera.name][vi, ui]
+        blocked = (measured > 0) & (measured < z - radius - margin) & (owners[camera.name][vi, ui] != track_id)
+        hidden &= ~inside | blocked
+    per_part = np.bincount(np.repeat(capsule_part, n), weights=hidden, minlength=num_parts)
+    total = np.bincount(np.repeat(capsule_part, n), minlength=num_parts)
+    return per_part > 0.5 * np.maximum(total, 1)
+
+
+def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str]) -> np.ndarray:
+    """``pose`` (D,) with the legs of ``sides`` ("left", "right") placed with their feet on
+    the floor: hip flexion and knee bend (abduction and rotation 0) that put the ankle at
+    the model's ankle height, the least bent such leg, the shin near vertical.
+
+    For legs hidden behind furniture: the paper keeps a hidden part's last seen
+    configuration relative to its parent, so straight legs sink through the floor when
+    the person sits down behind a table; feet stay on the floor while standing, sitting
+    down and getting up, so this is where hidden legs are most likely.
+    """
+    pose = np.array(pose, float)
+    hip, knee = np.meshgrid(PLANT_HIP, PLANT_KNEE, indexing="ij")
+    hip, knee = hip.reshape(-1), knee.reshape(-1)
+    for side in sides:
+        dofs = [model.dof_names.index(f"{side}_hip_{n}") for n in ("flex", "abd", "rot")]
+        bend = model.dof_names.index(f"{side}_knee")
+        candidates = np.repeat(pose[None], len(hip), axis=0)
+        candidates[:, dofs] = np.stack([hip, np.zeros_like(hip), np.zeros_like(hip)], axis=1)
+        candidates[:, bend] = knee
+        ankle = joints_from_poses(model, candidates)[:, JOINT_INDEX[f"{side}_ankle"]]
+        cost = np.abs(ankle[:, 2] - model.dims.ankle_height) + 0.05 * np.abs(knee - hip) + 0.01 * knee
+        pose = candidates[int(np.argmin(cost))]
+    return pose
