@@ -5,7 +5,8 @@ Kinect v1, 5 cm grid, procedural motion (the same scenes with or without the sha
 data). The frames are rendered first; the clock covers ``Tracker.update`` only, the first
 frame (start-up: numba's compiled code loaded from the cache) excluded, as in
 ``summary.json``. One person is also timed without the overlap of the grid update with
-the pose stage (the paper's IV-B concurrency, on by default in ``occupose track``). Three people: ``two_people_crossing`` with the walker of
+the pose stage (the paper's IV-B concurrency; off by default in ``occupose track``, where
+it was slower on an idle machine). Three people: ``two_people_crossing`` with the walker of
 ``no_occlusion`` added between them.
 """
 
@@ -24,7 +25,7 @@ from occupose.tracker import Tracker, track_frames
 
 TITLE = "Tracker speed: frames/s of `occupose track` (ours), start-up excluded, and ms per frame per stage"
 
-NUM_FRAMES = 150
+NUM_FRAMES = 300
 
 
 def _three_people():

@@ -612,13 +612,16 @@ def track_frames(tracker: Tracker, frames, num_frames: int, progress=None, overl
     return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, seconds, fps, num_frames)
 
 
-def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=None, overlap: bool = True,
+def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=None, overlap: bool = False,
                     **settings) -> TrackingResult:
     """Track every person of an open :class:`occupose.recording.Recording`.
 
     method, seed, settings : as :class:`Tracker` (settings: Method fields, ``cell``,
     ``grid_options``, ``max_gap_s``); progress : callable(n) after each frame, or None;
-    overlap : as :func:`track_frames` (measured faster: benchmarks/bench_speed.py).
+    overlap : as :func:`track_frames`; off by default: on an idle 2-core machine the grid's
+    thread competes with the likelihood kernels' two threads and one person ran at 62
+    against 68 frames/s without it (it paid only on a busy machine: 13.5 against 10.7 at
+    load 6; benchmarks/bench_speed.py).
     An empty recording (no frames) gives an empty result.
     """
     tracker = Tracker(recording.cameras, recording.fps, method, seed=seed, **settings)
