@@ -470,27 +470,27 @@ class Tracker:
             return None
         size = dims_from_observation(np.concatenate(self._pending.pop(tid)))
         rng = np.random.default_rng(self._seeds.spawn(1)[0])
-        standing = _Person(body_model(self.model_name, size.dims, size.girth), self.method, self.fps, rng)
-        views = self._views(observation, depths, standing.model)
+        person = _Person(body_model(self.model_name, size.dims, size.girth), self.method, self.fps, rng)
+        views = self._views(observation, depths, person.model)
         likelihood_obs = observation_from_views(views, self.method.max_points)
-        problem = standing.problem
+        problem = person.problem
         problem.set_observation(likelihood_obs)
         centre = np.mean(points, axis=0)
         headings = start_headings(self.blobs.states[tid].velocity, centre, self.cameras[0])
-        candidates = start_candidates(standing.model, centre, headings)
-        spread = self._spread(standing.model)
+        candidates = start_candidates(person.model, centre, headings)
+        spread = self._spread(person.model)
         samples = np.repeat(candidates, INIT_SAMPLES, axis=0)
         samples += rng.standard_normal(samples.shape) * spread
         samples = np.clip(samples, problem.limits[:, 0], problem.limits[:, 1])
         best = samples[int(np.argmax(problem.log_likelihood(samples).sum(axis=1)))]
-        standing.estimator.initialise(best, spread)
+        person.estimator.initialise(best, spread)
         for _ in range(INIT_STEPS):
-            best = standing.estimator.step(likelihood_obs)
-        standing.centroid = np.asarray(blob.centroid, float)
-        standing.blob = tid
-        standing.settle(best)
-        self.people[tid] = standing
-        return standing
+            best = person.estimator.step(likelihood_obs)
+        person.centroid = np.asarray(blob.centroid, float)
+        person.blob = tid
+        person.settle(best)
+        self.people[tid] = person
+        return person
 
     def _at_border(self, observation) -> bool:
         """Whether the person's pixels touch the left, right or top edge of a camera's image
@@ -538,11 +538,10 @@ class Tracker:
                 return person.estimate(False)
             active, scale = person.occlusion.active_dofs(), person.occlusion.diffusion_scale()
             person.problem.hidden_parts = ~person.part_visible
-        if not any(len(p) for p in observation.pixels.values()):
+        seen = observation_from_views(self._views(observation, depths, person.model), self.method.max_points)
+        if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
             return person.estimate(False)
-        views = self._views(observation, depths, person.model)
-        pose = person.estimator.step(observation_from_views(views, self.method.max_points),
-                                     active=active, diffusion_scale=scale)
+        pose = person.estimator.step(seen, active=active, diffusion_scale=scale)
         if person.occlusion is not None:
             person.occlusion.remember(pose)
             pose = person.occlusion.with_memory(pose)
