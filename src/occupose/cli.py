@@ -204,9 +204,9 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
     given = {"model": model, "filter": filter_name, "likelihood": likelihood, "particles": particles,
              "layers": layers}
     settings.update({k: v for k, v in given.items() if v is not None})
-    method = method or settings.pop("method", "ours")
-    seed = seed if seed is not None else settings.pop("seed", 0)
-    settings.pop("method", None), settings.pop("seed", None)
+    config_method, config_seed = settings.pop("method", "ours"), settings.pop("seed", 0)
+    method = method or config_method
+    seed = config_seed if seed is None else seed
     if isinstance(settings.get("layers"), list):
         settings["layers"] = tuple(settings["layers"])
     try:

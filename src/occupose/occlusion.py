@@ -161,6 +161,14 @@ class OcclusionState:
         return out
 
 
+def _dof_parts(model: BodyModel) -> np.ndarray:
+    """(D,) int, the part (weight group) each DOF of ``model`` belongs to."""
+    owner = np.full(model.num_dofs, -1)
+    for k, group in enumerate(model.weight_groups):
+        owner[group.dofs] = k
+    return owner
+
+
 def part_tree(model: BodyModel) -> tuple[list[int], list[np.ndarray]]:
     """Parent part of each part (-1 for the root) and the DOFs that place each part relative
     to its parent (the model's weight groups), for the occlusion state machine.
@@ -168,9 +176,7 @@ def part_tree(model: BodyModel) -> tuple[list[int], list[np.ndarray]]:
     A part's parent is the part owning the DOFs of the nearest ancestor node with DOFs.
     Raises ValueError for a model whose parts are not in parent-first order.
     """
-    owner = np.full(model.num_dofs, -1)
-    for k, group in enumerate(model.weight_groups):
-        owner[group.dofs] = k
+    owner = _dof_parts(model)
     node_part = np.full(len(model.node_names), -1)
     for d in range(model.num_dofs):
         node_part[model.dof_node[d]] = owner[d]
@@ -189,16 +195,14 @@ def part_tree(model: BodyModel) -> tuple[list[int], list[np.ndarray]]:
 def joint_parts(model: BodyModel) -> list[np.ndarray]:
     """For each canonical joint, the parts whose DOFs place it (empty where the model does
     not report the joint): a joint is visible when all of them are."""
-    owner = np.full(model.num_dofs, -1)
-    for k, group in enumerate(model.weight_groups):
-        owner[group.dofs] = k
+    owner = _dof_parts(model)
     out = []
     for node in model.joint_nodes:
         if node < 0:
             out.append(np.zeros(0, int))
             continue
-        chain, up = [], int(model.parents[node])
-        chain.append(int(node)) if up < 0 else None  # the root is placed by its own DOFs
+        up = int(model.parents[node])
+        chain = [int(node)] if up < 0 else []  # the root is placed by its own DOFs
         while up >= 0:
             chain.append(up)
             up = int(model.parents[up])
