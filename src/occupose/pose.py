@@ -13,6 +13,11 @@ import numpy as np
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
 from occupose.filters import apply_limits, make_filter
 from occupose.likelihood import Observation, make_likelihood
+from occupose.proposals import ARM_DOFS, SIDES, arm_proposals
+
+
+#: Default share of the particles given to the arm proposals (see PoseEstimator).
+PROPOSAL_SHARE = 0.1
 
 
 class PoseProblem:
@@ -128,14 +133,20 @@ class PoseEstimator:
     filter : a name of occupose.filters.FILTERS; particles : number of particles;
     rng : np.random.Generator; velocity_damping : share of the root's last translation
     added to every particle before a step (constant-velocity prediction; 0 = none);
+    proposals : share of the particles whose arm tries where the points unexplained by
+    the last estimate suggest (:func:`occupose.proposals.arm_proposals`; 0 = none);
     filter_options : e.g. ``num_layers``
     """
 
     def __init__(self, problem: PoseProblem, filter: str, particles: int, rng: np.random.Generator,
-                 velocity_damping: float = 0.8, **filter_options):
+                 velocity_damping: float = 0.8, proposals: float = PROPOSAL_SHARE, **filter_options):
+        if not 0.0 <= proposals < 1.0:
+            raise ValueError(f"proposals (a share of the particles) must be in [0, 1), got {proposals!r}")
         self.problem = problem
         self.filter = make_filter(filter, problem, particles, rng, **filter_options)
         self.velocity_damping = velocity_damping
+        self.proposals = proposals
+        self._rng = rng
         self._previous = None
 
     def initialise(self, pose: np.ndarray, spread: float | np.ndarray = 0.0) -> None:
@@ -172,7 +183,23 @@ class PoseEstimator:
                 drift[~active] = 0.0
             self.filter.particles = self.filter.particles + drift
             self._previous = current.copy()
+        if self.proposals > 0 and current is not None:
+            self._propose(current, observation.points, active)
         return self.filter.step(active=active, diffusion_scale=diffusion_scale)
+
+    def _propose(self, current: np.ndarray, points: np.ndarray, active: np.ndarray | None) -> None:
+        """Set the arm DOFs of a random share of the particles to each arm proposal (arms
+        of the model only, and only where every DOF of the arm is active)."""
+        model = self.problem.model
+        if not all(f"{side}_{name}" in model.dof_names for side in SIDES for name in ARM_DOFS):
+            return
+        count = int(round(self.proposals * self.filter.num_particles))
+        particles = self.filter.particles.copy()
+        for dofs, values in arm_proposals(model, current, points):
+            if active is None or active[dofs].all():
+                chosen = self._rng.choice(len(particles), count, replace=False)
+                particles[np.ix_(chosen, dofs)] = values
+        self.filter.particles = particles
 
     def joints(self, pose: np.ndarray) -> np.ndarray:
         """(15, 3) canonical joints of ``pose`` (NaN for joints the model does not report)."""

@@ -1,0 +1,76 @@
+"""Data-driven arm proposals: a few particles try each arm where its points are.
+
+An annealed search turns a limb by a few tenths of a radian per frame. An arm the filter
+has lost (left hanging while the person raised it, or left behind the torso where no
+point says where it is) is not found again by diffusion: the poses in between lie in
+space the camera sees as empty, which the free-space term penalises. The points tell where
+it is, though: those farther than ``unexplained`` from the current estimate's surface and
+within reach of a shoulder (nearer that shoulder than the other). When an arm has at least
+``min_points`` of them, the point at their 90th percentile of distance from the shoulder
+is taken as the hand, the arm is straightened towards it, and the arm's joint angles of
+that pose (the analytic inverse kinematics of :func:`occupose.body.pose_from_joints`)
+replace those of a share of the particles before the filter's step. The filter's weights
+decide: a proposal that does not explain the points better dies at the first resampling.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from occupose.body import BodyModel, capsules_from_poses, joints_from_poses, pose_from_joints
+from occupose.joints import JOINT_INDEX
+from occupose.likelihood import point_distances
+
+#: Default distance, metres, beyond which a point is not explained by the estimate.
+UNEXPLAINED = 0.05
+#: Default least number of unexplained points that make an arm proposal.
+MIN_POINTS = 10
+#: Reach of an arm beyond its upper arm + forearm (the hand), as a factor.
+REACH = 1.25
+SIDES = ("left", "right")
+ARM_DOFS = ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")
+
+
+def arm_dofs(model: BodyModel, side: str) -> np.ndarray:
+    """(4,) int64: the DOFs of ``side``'s arm that a proposal sets (shoulder flex, abd, rot
+    and elbow; a forearm twist is left to the filter)."""
+    return np.array([model.dof_names.index(f"{side}_{name}") for name in ARM_DOFS], np.int64)
+
+
+def arm_proposals(model: BodyModel, pose: np.ndarray, points: np.ndarray, *, unexplained: float = UNEXPLAINED,
+                  min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The arm poses that the points unexplained by ``pose`` suggest.
+
+    model : the body model; pose : (D,) the current estimate; points : (N, 3) world metres
+    Returns a list of (dofs (n,) int64, values (n,) float64), one per arm with evidence.
+    """
+    points = np.asarray(points, float)
+    if len(points) < min_points:
+        return []
+    a, b = capsules_from_poses(model, pose[None])
+    distance, _ = point_distances(a, b, model.capsule_radii, points)
+    loose = points[distance[0] > unexplained]
+    if len(loose) < min_points:
+        return []
+    joints = joints_from_poses(model, pose[None])[0]
+    shoulders = np.array([joints[JOINT_INDEX[f"{side}_shoulder"]] for side in SIDES])
+    to_shoulder = np.linalg.norm(loose[:, None, :] - shoulders[None], axis=2)  # (M, 2)
+    nearer = np.argmin(to_shoulder, axis=1)
+    proposals = []
+    for s, side in enumerate(SIDES):
+        shoulder, elbow, wrist = (joints[JOINT_INDEX[f"{side}_{j}"]] for j in ("shoulder", "elbow", "wrist"))
+        upper, fore = np.linalg.norm(elbow - shoulder), np.linalg.norm(wrist - elbow)
+        reach = to_shoulder[:, s]
+        mine = (nearer == s) & (reach < REACH * (upper + fore)) & (reach > upper)
+        if mine.sum() < min_points:
+            continue
+        mine = np.flatnonzero(mine)
+        hand = loose[mine[np.argsort(reach[mine])[int(0.9 * (len(mine) - 1))]]]
+        direction = (hand - shoulder) / np.linalg.norm(hand - shoulder)
+        target = joints.copy()
+        target[JOINT_INDEX[f"{side}_elbow"]] = shoulder + upper * direction
+        target[JOINT_INDEX[f"{side}_wrist"]] = shoulder + (upper + fore) * direction
+        target[~model.reported_joints] = np.nan
+        dofs = arm_dofs(model, side)
+        proposals.append((dofs, pose_from_joints(model, target, refine=False)[dofs]))
+    return proposals

@@ -1,0 +1,103 @@
+"""Data-driven arm proposals: where they point, when there are none, and what they fix."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from occupose.body import body_model, capsules_from_poses, joints_from_poses, standing_pose
+from occupose.joints import JOINT_INDEX
+from occupose.likelihood import Observation
+from occupose.pose import PoseEstimator, PoseProblem
+from occupose.proposals import arm_dofs, arm_proposals
+
+WRIST = JOINT_INDEX["right_wrist"]
+
+
+def _surface_points(model, pose, rng, count=1000):
+    """(count, 3) points on the capsules' sides of ``pose``, spread by capsule length
+    (a stand-in for a depth camera that sees the body from every side)."""
+    a, b = (x[0] for x in capsules_from_poses(model, pose[None]))
+    lengths = np.linalg.norm(b - a, axis=1) + 1e-3
+    capsule = rng.choice(len(a), count, p=lengths / lengths.sum())
+    t = rng.random(count)
+    axis = (b - a)[capsule] / lengths[capsule, None]
+    side = np.cross(axis, rng.normal(size=(count, 3)))
+    side /= np.linalg.norm(side, axis=1, keepdims=True)
+    radius = model.capsule_radii[capsule, 0] * (1 - t) + model.capsule_radii[capsule, 1] * t
+    return a[capsule] + t[:, None] * (b - a)[capsule] + radius[:, None] * side
+
+
+@pytest.fixture(scope="module")
+def raised():
+    """(model, the pose with the right arm hanging, the pose with it raised to the side,
+    points on the raised pose)."""
+    model = body_model("full")
+    hanging = standing_pose(model, (0.0, 2.5), 0.0)
+    pose = hanging.copy()
+    pose[model.dof_names.index("right_shoulder_abd")] = 1.5
+    return model, hanging, pose, _surface_points(model, pose, np.random.default_rng(0))
+
+
+def test_arm_dofs_are_shoulder_and_elbow_of_that_side():
+    model = body_model("upper")
+    assert [model.dof_names[d] for d in arm_dofs(model, "left")] == [
+        "left_shoulder_flex", "left_shoulder_abd", "left_shoulder_rot", "left_elbow"]
+
+
+def test_a_lost_arm_is_proposed_where_its_points_are(raised):
+    model, hanging, pose, points = raised
+    proposals = arm_proposals(model, hanging, points)
+    assert len(proposals) == 1  # the left arm is where its points are
+    dofs, values = proposals[0]
+    assert np.array_equal(dofs, arm_dofs(model, "right"))
+    proposed = hanging.copy()
+    proposed[dofs] = values
+    wrist = joints_from_poses(model, proposed[None])[0, WRIST]
+    true_wrist = joints_from_poses(model, pose[None])[0, WRIST]
+    hanging_wrist = joints_from_poses(model, hanging[None])[0, WRIST]
+    assert np.linalg.norm(hanging_wrist - true_wrist) > 0.5
+    assert np.linalg.norm(wrist - true_wrist) < 0.08
+
+
+def test_no_proposal_when_the_estimate_explains_the_points(raised):
+    model, _, pose, points = raised
+    assert arm_proposals(model, pose, points) == []
+    assert arm_proposals(model, pose, points[:5]) == []
+
+
+def _track_static(model, start, points, proposals, active=None, frames=6):
+    estimator = PoseEstimator(PoseProblem(model, "points"), "apf+ps", 200, np.random.default_rng(0),
+                              proposals=proposals, num_layers=[3, 1, 1])
+    estimator.initialise(start, 0.0)
+    observation = Observation(points, ())
+    for _ in range(frames):
+        pose = estimator.step(observation, active=active)
+    return pose
+
+
+def test_proposals_let_the_filter_find_a_lost_arm_that_diffusion_does_not(raised):
+    """Six frames of the same points, apf+ps 200 x [3, 1, 1] from the arm hanging (wrist
+    0.5+ m away): measured wrist error 19.8 cm without proposals (diffusion alone, even
+    with no free-space term in the way), 1.3 cm with 10 % proposals."""
+    model, hanging, pose, points = raised
+    true_wrist = joints_from_poses(model, pose[None])[0, WRIST]
+    errors = {}
+    for share in (0.0, 0.1):
+        found = _track_static(model, hanging, points, share)
+        errors[share] = np.linalg.norm(joints_from_poses(model, found[None])[0, WRIST] - true_wrist)
+    assert errors[0.0] > 0.15, errors
+    assert errors[0.1] < 0.04, errors
+
+
+def test_a_frozen_arm_gets_no_proposal(raised):
+    model, hanging, _, points = raised
+    active = np.ones(model.num_dofs, bool)
+    active[arm_dofs(model, "right")] = False
+    found = _track_static(model, hanging, points, 0.1, active=active, frames=2)
+    np.testing.assert_allclose(found[arm_dofs(model, "right")], hanging[arm_dofs(model, "right")], atol=1e-12)
+
+
+def test_estimator_rejects_a_bad_proposal_share():
+    with pytest.raises(ValueError, match="proposals"):
+        PoseEstimator(PoseProblem(body_model("full")), "sir", 10, np.random.default_rng(0), proposals=1.0)
