@@ -9,7 +9,7 @@ from occupose.body import body_model, capsules_from_poses, joints_from_poses, st
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation
 from occupose.pose import PoseEstimator, PoseProblem
-from occupose.proposals import arm_dofs, arm_proposals
+from occupose.proposals import arm_dofs, arm_proposals, reach_towards
 
 WRIST = JOINT_INDEX["right_wrist"]
 
@@ -58,6 +58,22 @@ def test_a_lost_arm_is_proposed_where_its_points_are(raised):
     hanging_wrist = joints_from_poses(model, hanging[None])[0, WRIST]
     assert np.linalg.norm(hanging_wrist - true_wrist) > 0.5
     assert np.linalg.norm(wrist - true_wrist) < 0.08
+
+
+def test_reach_towards_bends_the_arm_where_its_points_are_and_straightens_it_out_of_reach():
+    shoulder = np.array([0.0, 0.0, 1.4])
+    elbow = shoulder + [0.3, 0.0, 0.0]  # upper arm forwards, forearm up: a bent arm, hand 0.42 m away
+    hand = elbow + [0.0, 0.0, 0.3]
+    t = np.linspace(0.0, 1.0, 30)[:, None]
+    points = np.concatenate([shoulder + t * (elbow - shoulder), elbow + t * (hand - elbow)])
+    got_elbow, got_wrist = reach_towards(shoulder, hand, 0.3, 0.3, points)
+    assert np.array_equal(got_wrist, hand)
+    assert np.linalg.norm(got_elbow - elbow) < 0.05  # of the 8 places on the circle, the nearest one
+    assert abs(np.linalg.norm(got_elbow - shoulder) - 0.3) < 1e-9 and abs(np.linalg.norm(hand - got_elbow) - 0.3) < 1e-9
+    far = shoulder + [0.0, 0.9, 0.0]
+    got_elbow, got_wrist = reach_towards(shoulder, far, 0.3, 0.3, points)
+    np.testing.assert_allclose(got_elbow, shoulder + [0.0, 0.3, 0.0])
+    np.testing.assert_allclose(got_wrist, shoulder + [0.0, 0.6, 0.0])
 
 
 def test_no_proposal_when_the_estimate_explains_the_points(raised):
