@@ -55,6 +55,12 @@ class PoseProblem:
                                                      everything) for group in stages]
         self.weight_groups = PART_WEIGHTS[part_weights](model)
         self.hidden_parts = np.zeros(len(model.part_names), bool)
+        #: (direction, weight): the way the person walks (radians, world) and the nats that
+        #: facing the opposite way costs, weight (1 - cos(heading - direction)) / 2 on the
+        #: heading's part (people walk forwards); None for none. Set per frame by the tracker.
+        self.walking: tuple[float, float] | None = None
+        self._heading = model.dof_names.index("heading") if "heading" in model.dof_names else None
+        self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self._heading in g.dofs), None)
         self._likelihood = None
 
     def set_observation(self, observation: Observation) -> None:
@@ -68,6 +74,9 @@ class PoseProblem:
         a, b = capsules_from_poses(self.model, poses)
         out = self._likelihood.evaluate(a, b, self.model.capsule_radii, self.model.capsule_part,
                                         len(self.model.part_names))
+        if self.walking is not None and self._heading_part is not None:
+            direction, weight = self.walking
+            out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self._heading] - direction))
         out[:, self.hidden_parts] = 0.0
         return out
 
@@ -195,7 +204,10 @@ class PoseEstimator:
             return
         count = int(round(self.proposals * self.filter.num_particles))
         particles = self.filter.particles.copy()
-        for dofs, values in arm_proposals(model, current, points):
+        proposals = arm_proposals(model, current, points)
+        if self.problem.walking is not None and self.problem._heading is not None:
+            proposals.append((np.array([self.problem._heading]), np.array([self.problem.walking[0]])))
+        for dofs, values in proposals:
             if active is None or active[dofs].all():
                 chosen = self._rng.choice(len(particles), count, replace=False)
                 particles[np.ix_(chosen, dofs)] = values

@@ -145,6 +145,12 @@ MAX_ANCHOR = 0.25
 WALKING_SPEED = 0.3
 BACKWARDS = np.deg2rad(135.0)
 START_CHECK_S = 2.0
+#: A walking person faces the way it walks: frames over which the way is taken, the nats
+#: that facing backwards costs at full speed and the speed above WALKING_SPEED (m/s) at
+#: which the prior is at full weight (see _Person.walking).
+WALK_FRAMES = 10
+WALK_PRIOR = 1.0
+WALK_RAMP = 0.4
 #: The upper-body model sees only the points above this share of the person's stature
 #: (the hips are at about 0.53).
 UPPER_CUT = 0.5
@@ -231,6 +237,18 @@ class _Person:
             self.estimator.shift(turn)
             self.pose = self.estimator.filter.estimate.copy()
             self.since_turn = 0
+
+    def walking(self) -> tuple[float, float] | None:
+        """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
+        WALK_FRAMES estimates, weighted WALK_PRIOR nats from WALKING_SPEED + WALK_RAMP m/s
+        up (linearly from 0 at WALKING_SPEED); None when slower or too new."""
+        if len(self.path) < WALK_FRAMES:
+            return None
+        velocity = (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
+        speed = float(np.hypot(*velocity))
+        if speed <= WALKING_SPEED:
+            return None
+        return float(np.arctan2(velocity[1], velocity[0])), WALK_PRIOR * min(1.0, (speed - WALKING_SPEED) / WALK_RAMP)
 
     def carry(self) -> None:
         """A frame without an estimate (gone or suspended): the pose walks on at the pelvis's
@@ -541,6 +559,7 @@ class Tracker:
         seen = observation_from_views(self._views(observation, depths, person.model), self.method.max_points)
         if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
             return person.estimate(False)
+        person.problem.walking = person.walking()
         pose = person.estimator.step(seen, active=active, diffusion_scale=scale)
         if person.occlusion is not None:
             person.occlusion.remember(pose)
