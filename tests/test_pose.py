@@ -118,6 +118,23 @@ def test_log_likelihood_per_part_true_pose_beats_perturbed_and_hidden_parts_give
                           np.delete(values, model.part_names.index("left_shin"), axis=1))
 
 
+def test_walking_costs_facing_away_from_the_way_walked_on_the_heading_part(walk):
+    gt, observations = walk
+    model = body_model("full", dims=dims_from_joints(gt))
+    problem = PoseProblem(model)
+    problem.set_observation(observations[0])
+    pose = pose_from_joints(model, gt[0])
+    heading = model.dof_names.index("heading")
+    poses = np.repeat(pose[None], 3, axis=0)
+    poses[:, heading] += [0.0, np.pi / 2, np.pi]
+    free = problem.log_likelihood(poses)
+    problem.walking = (pose[heading], 2.0)
+    walking = problem.log_likelihood(poses)
+    torso = model.part_names.index("torso")
+    np.testing.assert_allclose((walking - free)[:, torso], [0.0, -1.0, -2.0], atol=1e-9)
+    assert np.all(np.delete(walking - free, torso, axis=1) == 0.0)
+
+
 def test_part_weights_chain_weighs_each_group_by_its_chain_to_the_root():
     model = body_model("upper")
     names = model.part_names

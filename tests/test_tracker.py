@@ -19,7 +19,12 @@ from occupose.synth.scenarios import build_scenario
 from occupose.tracker import (
     INIT_FRAMES,
     METHODS,
+    WALK_FRAMES,
+    WALK_FROM,
+    WALK_PRIOR,
+    WALK_RAMP,
     Tracker,
+    _Person,
     track_frames,
 )
 
@@ -254,3 +259,16 @@ def test_a_person_cut_by_the_image_edge_does_not_start():
     assert tracker._at_border(observation((20, 110), (0, 30)))  # left edge
     assert tracker._at_border(observation((20, 110), (140, 160)))  # right edge
     assert tracker._at_border(observation((0, 60), (60, 90)))  # top edge
+
+
+def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
+    person = _Person(body_model("full"), METHODS["ours"], 30.0, np.random.default_rng(0))
+    assert person.walking() is None  # no path yet
+    person.path = [np.array([0.0, 0.04 * i]) for i in range(WALK_FRAMES)]  # 1.2 m/s along +y
+    direction, weight = person.walking()
+    assert direction == pytest.approx(np.pi / 2) and weight == pytest.approx(WALK_PRIOR)
+    person.path = [np.array([-0.02 * i, 0.0]) for i in range(WALK_FRAMES)]  # 0.6 m/s along -x
+    direction, weight = person.walking()
+    assert abs(direction) == pytest.approx(np.pi) and weight == pytest.approx(WALK_PRIOR * (0.6 - WALK_FROM) / WALK_RAMP)
+    person.path = [np.array([0.01 * i, 0.0]) for i in range(WALK_FRAMES)]  # 0.3 m/s: standing, swaying
+    assert person.walking() is None

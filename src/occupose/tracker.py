@@ -146,10 +146,13 @@ WALKING_SPEED = 0.3
 BACKWARDS = np.deg2rad(135.0)
 START_CHECK_S = 2.0
 #: A walking person faces the way it walks: frames over which the way is taken, the nats
-#: that facing backwards costs at full speed and the speed above WALKING_SPEED (m/s) at
-#: which the prior is at full weight (see _Person.walking).
-WALK_FRAMES = 10
+#: that facing backwards costs at full speed, and the speeds (m/s) from which the prior
+#: starts and over which it ramps up to full weight (see _Person.walking). A person
+#: standing still moves its estimated pelvis by a few centimetres per frame, which over
+#: 0.5 s stays well below WALK_FROM.
+WALK_FRAMES = 15
 WALK_PRIOR = 1.0
+WALK_FROM = 0.5
 WALK_RAMP = 0.4
 #: The upper-body model sees only the points above this share of the person's stature
 #: (the hips are at about 0.53).
@@ -240,15 +243,15 @@ class _Person:
 
     def walking(self) -> tuple[float, float] | None:
         """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
-        WALK_FRAMES estimates, weighted WALK_PRIOR nats from WALKING_SPEED + WALK_RAMP m/s
-        up (linearly from 0 at WALKING_SPEED); None when slower or too new."""
+        WALK_FRAMES estimates, weighted WALK_PRIOR nats from WALK_FROM + WALK_RAMP m/s up
+        (linearly from 0 at WALK_FROM); None when slower or too new."""
         if len(self.path) < WALK_FRAMES:
             return None
         velocity = (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
         speed = float(np.hypot(*velocity))
-        if speed <= WALKING_SPEED:
+        if speed <= WALK_FROM:
             return None
-        return float(np.arctan2(velocity[1], velocity[0])), WALK_PRIOR * min(1.0, (speed - WALKING_SPEED) / WALK_RAMP)
+        return float(np.arctan2(velocity[1], velocity[0])), WALK_PRIOR * min(1.0, (speed - WALK_FROM) / WALK_RAMP)
 
     def carry(self) -> None:
         """A frame without an estimate (gone or suspended): the pose walks on at the pelvis's
