@@ -160,6 +160,9 @@ UPPER_CUT = 0.5
 #: A new blob track within this distance of a lost person's carried pelvis is that
 #: person's, metres (horizontal).
 REJOIN_M = 1.0
+#: A blob whose centroid is within this distance of a tracked person's pelvis does not
+#: start a new person (it split off that person's blob), metres (horizontal).
+START_CLEARANCE = 0.5
 def _model_for(cameras: Sequence[Camera]) -> str:
     """'upper' when every camera looks down more steeply than STEEP_DOWN, else 'full'."""
     steep = [np.arcsin(np.clip(-c.world_from_camera[2, 2], -1, 1)) > STEEP_DOWN for c in cameras]
@@ -362,6 +365,7 @@ class Tracker:
         self._seeds = np.random.SeedSequence(seed)
         self._previous = {}
         self._pending: dict[int, list[np.ndarray]] = {}  # points of tracks not yet started
+        self._fragments: set[int] = set()  # blob tracks that split off a tracked person's (see _start)
         self.frame = -1
         self.seconds = {"grid": 0.0, "blobs": 0.0, "observations": 0.0, "pose": 0.0}
         self.last_assigned: dict[str, np.ndarray] = {}
@@ -404,6 +408,7 @@ class Tracker:
         self._rejoin(seen, states)
         owner = {person.blob: pid for pid, person in self.people.items()}
         self._pending = {t: p for t, p in self._pending.items() if t in seen and t not in owner}
+        self._fragments &= set(seen) - set(owner)
         clock = self._tick("blobs", clock)
         bodies = {t: self.people[owner[t]].body_distance() for t in seen if t in owner}
         bodies |= predicted_from_tracks(states, self._previous, self.fps, ids=[t for t in seen if t not in bodies])
@@ -438,11 +443,13 @@ class Tracker:
         is not seen) whose carried pelvis is within REJOIN_M of the blob's centroid: a person
         coming out from behind a cabinet often comes back as a new blob track, because the
         blob's centroid stalls at the cabinet's edge while they disappear, so the blob
-        tracker's prediction falls short of where they reappear."""
+        tracker's prediction falls short of where they reappear. A blob that split off a
+        person's (kept from starting by START_CLEARANCE) may be taken at any age: the person
+        whose blob went on without it may continue as it."""
         owned = {person.blob for person in self.people.values()}
         lost = {pid: person for pid, person in self.people.items() if person.lost and person.blob not in seen}
         for tid in seen:
-            if tid in owned or tid in self._pending or not lost or states[tid].age > 0:
+            if tid in owned or tid in self._pending or not lost or (states[tid].age > 0 and tid not in self._fragments):
                 continue
             pid, gap = min(((pid, float(np.hypot(*(p.pose[:2] - states[tid].centroid[:2])))) for pid, p in lost.items()),
                            key=lambda item: item[1])
@@ -485,6 +492,11 @@ class Tracker:
         if blob.top < MIN_INIT_TOP or len(points) < MIN_INIT_POINTS or self._at_border(observation):
             self._pending.pop(tid, None)
             return None
+        centroid = self.blobs.states[tid].centroid[:2]
+        if any(np.hypot(*(p.pose[:2] - centroid)) < START_CLEARANCE for p in self.people.values() if not p.lost):
+            self._pending.pop(tid, None)  # a piece of a tracked person's body split off its blob
+            self._fragments.add(tid)
+            return None
         pending = self._pending.setdefault(tid, [])
         pending.append(points)
         if len(pending) < INIT_FRAMES:
@@ -514,17 +526,19 @@ class Tracker:
         return person
 
     def _at_border(self, observation) -> bool:
-        """Whether the person's pixels touch the left, right or top edge of a camera's image
-        (within BORDER_PX): not fully in view, so its points would misjudge its size. (The
-        bottom edge is allowed: a camera may cut the feet of a person who is near it.)"""
+        """Whether the person's pixels touch the left, right or top edge (within BORDER_PX)
+        of every camera's image that sees them: not fully in view of any camera, so its
+        points would misjudge its size. (The bottom edge is allowed: a camera may cut the
+        feet of a person who is near it. With several cameras, one that sees the whole
+        person is enough: the pooled points hold the whole body.)"""
+        cut = []
         for camera in self.cameras:
             pixels = observation.pixels[camera.name]
             if len(pixels) == 0:
                 continue
             v, u = np.divmod(pixels, camera.width)
-            if u.min() < BORDER_PX or u.max() >= camera.width - BORDER_PX or v.min() < BORDER_PX:
-                return True
-        return False
+            cut.append(bool(u.min() < BORDER_PX or u.max() >= camera.width - BORDER_PX or v.min() < BORDER_PX))
+        return all(cut)
 
     @staticmethod
     def _spread(model: BodyModel) -> np.ndarray:
@@ -542,6 +556,7 @@ class Tracker:
             person.estimator.shift(offset)
             person.pose = person.pose + offset
             person.centroid, person.lost = centroid, False
+            person.path = []  # its way over the gap is unknown: no walking prior until it has walked again
         moved = person.pose.copy()
         moved[:2] += centroid[:2] - person.centroid[:2]
         person.centroid = centroid
