@@ -1,6 +1,8 @@
 """The tracker end to end on short synthetic scenes, its parts, and bad input."""
 
 import json
+from dataclasses import replace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -259,6 +261,48 @@ def test_a_person_cut_by_the_image_edge_does_not_start():
     assert tracker._at_border(observation((20, 110), (0, 30)))  # left edge
     assert tracker._at_border(observation((20, 110), (140, 160)))  # right edge
     assert tracker._at_border(observation((0, 60), (60, 90)))  # top edge
+
+
+def test_with_two_cameras_one_that_sees_the_whole_person_is_enough_to_start():
+    front, side = _camera(), replace(_camera(), name="side")
+    tracker = Tracker([front, side], 30.0)
+
+    def pixels(rows, cols):
+        v, u = np.meshgrid(np.arange(*rows), np.arange(*cols), indexing="ij")
+        return np.sort((v * front.width + u).reshape(-1))
+
+    def observation(front_pixels, side_pixels):
+        return GridObservation(1, {"cam": front_pixels, "side": side_pixels},
+                               {"cam": np.zeros((front_pixels.size, 3)), "side": np.zeros((side_pixels.size, 3))})
+
+    whole, cut, none = pixels((20, 110), (60, 90)), pixels((20, 110), (0, 30)), np.zeros(0, np.int64)
+    assert not tracker._at_border(observation(whole, cut))
+    assert not tracker._at_border(observation(cut, whole))
+    assert tracker._at_border(observation(cut, cut))
+    assert tracker._at_border(observation(cut, none))  # the only camera that sees it cuts it
+    assert tracker._at_border(observation(none, none))
+
+
+def test_a_blob_next_to_a_tracked_person_does_not_start_another(walk, monkeypatch):
+    """A second blob 0.3 m from a tracked person's pelvis (a piece of the body split off
+    its blob) is kept from starting a person; one 1.5 m away starts."""
+    scenario, rendered = walk
+    tracker = Tracker(scenario.cameras, scenario.fps, "ours", seed=0)
+    for f in rendered[:12]:
+        out = tracker.update(f.depth)
+    assert list(out) == [1]
+    person = tracker.people[1]
+    tid, observation = 99, tracker._previous[1]
+    states = dict(tracker.blobs.states)  # a blob track 99 beside the person's
+    monkeypatch.setattr(type(tracker.blobs), "states", property(lambda self: states))
+    for offset, starts in ((0.3, False), (1.5, True)):
+        states[tid] = replace(states[1], centroid=np.array([*(person.pose[:2] + [offset, 0.0]), 1.0]))
+        tracker._pending.pop(tid, None)
+        blob = SimpleNamespace(top=1.8, centroid=states[tid].centroid)  # person-like
+        started = [tracker._start(tid, observation, rendered[11].depth, tracker.last_assigned, blob)
+                   for _ in range(INIT_FRAMES)]
+        assert (started[-1] is not None) == starts
+        assert tid in tracker._fragments  # since the first, near offset
 
 
 def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
