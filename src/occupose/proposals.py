@@ -18,6 +18,7 @@ points better dies at the first resampling.
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from occupose.body import BodyModel, capsules_from_poses, joints_from_poses, pose_from_joints
 from occupose.joints import JOINT_INDEX
@@ -71,8 +72,9 @@ def arm_proposals(model: BodyModel, pose: np.ndarray, points: np.ndarray, *, une
         mine = np.flatnonzero(mine)
         hand = loose[mine[np.argsort(reach[mine])[int(0.9 * (len(mine) - 1))]]]
         target = joints.copy()
+        within = points[np.linalg.norm(points - shoulder, axis=1) < REACH * (upper + fore)]
         target[JOINT_INDEX[f"{side}_elbow"]], target[JOINT_INDEX[f"{side}_wrist"]] = reach_towards(
-            shoulder, hand, upper, fore, points)
+            shoulder, hand, upper, fore, within)
         target[~model.reported_joints] = np.nan
         dofs = arm_dofs(model, side)
         proposals.append((dofs, pose_from_joints(model, target, refine=False)[dofs]))
@@ -104,5 +106,5 @@ def reach_towards(shoulder: np.ndarray, hand: np.ndarray, upper: float, fore: fl
     t = np.linspace(0.1, 0.9, 5)[None, :, None]
     samples = np.concatenate([shoulder + t * (elbows[:, None] - shoulder),
                               elbows[:, None] + t * (hand - elbows[:, None])], axis=1)  # (E, 10, 3)
-    nearest = np.sqrt(((samples[:, :, None, :] - points[None, None]) ** 2).sum(axis=3)).min(axis=2)
+    nearest = cKDTree(points).query(samples.reshape(-1, 3))[0].reshape(samples.shape[:2])
     return elbows[np.argmin(nearest.mean(axis=1))], hand
