@@ -59,8 +59,9 @@ class PoseProblem:
         #: facing the opposite way costs, weight (1 - cos(heading - direction)) / 2 on the
         #: heading's part (people walk forwards); None for none. Set per frame by the tracker.
         self.walking: tuple[float, float] | None = None
-        self._heading = model.dof_names.index("heading") if "heading" in model.dof_names else None
-        self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self._heading in g.dofs), None)
+        #: The index of the model's heading DOF, or None for a model without one.
+        self.heading_dof = model.dof_names.index("heading") if "heading" in model.dof_names else None
+        self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self.heading_dof in g.dofs), None)
         self._likelihood = None
 
     def set_observation(self, observation: Observation) -> None:
@@ -76,7 +77,7 @@ class PoseProblem:
                                         len(self.model.part_names))
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
-            out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self._heading] - direction))
+            out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
         out[:, self.hidden_parts] = 0.0
         return out
 
@@ -205,8 +206,8 @@ class PoseEstimator:
         count = int(round(self.proposals * self.filter.num_particles))
         particles = self.filter.particles.copy()
         proposals = arm_proposals(model, current, points)
-        if self.problem.walking is not None and self.problem._heading is not None:
-            proposals.append((np.array([self.problem._heading]), np.array([self.problem.walking[0]])))
+        if self.problem.walking is not None and self.problem.heading_dof is not None:
+            proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
         for dofs, values in proposals:
             if active is None or active[dofs].all():
                 chosen = self._rng.choice(len(particles), count, replace=False)

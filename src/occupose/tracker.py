@@ -163,6 +163,8 @@ REJOIN_M = 1.0
 #: A blob whose centroid is within this distance of a tracked person's pelvis does not
 #: start a new person (it split off that person's blob), metres (horizontal).
 START_CLEARANCE = 0.5
+
+
 def _model_for(cameras: Sequence[Camera]) -> str:
     """'upper' when every camera looks down more steeply than STEEP_DOWN, else 'full'."""
     steep = [np.arcsin(np.clip(-c.world_from_camera[2, 2], -1, 1)) > STEEP_DOWN for c in cameras]
