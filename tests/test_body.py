@@ -8,7 +8,7 @@ import pytest
 
 from scipy import stats
 
-from occupose.body import (BODY_MODELS, body_model, capsules_from_poses, diffuse, diffusion_scales,
+from occupose.body import (BODY_MODELS, arm_angles, body_model, capsules_from_poses, diffuse, diffusion_scales,
                            dims_from_observation, joints_from_poses, pose_from_joints, root_drift,
                            standing_pose)
 from occupose.camera import points_from_depth
@@ -273,6 +273,22 @@ def test_pose_from_joints_recovers_the_pose(rng):
     fitted = pose_from_joints(m, joints_from_poses(m, pose[None])[0])
     determined = np.array([n != "neck_twist" for n in m.dof_names])
     np.testing.assert_allclose(fitted[determined], pose[determined], atol=1e-4)
+
+
+@pytest.mark.parametrize("name", ["full", "upper"])
+def test_arm_angles_give_back_an_arm_of_a_leaning_turned_body(name):
+    """The arm's angles from its own shoulder, elbow and wrist, in a torso turned and
+    leaning (and bent sideways, for the full model): the arm of the pose, other DOFs kept."""
+    m = BODY_MODELS[name]
+    pose = standing_pose(m, (0.5, 1.0), -2.0)
+    for dof, value in (("trunk_lean", 0.4), ("trunk_side", 0.2), ("right_shoulder_flex", 0.9),
+                       ("right_shoulder_abd", 0.5), ("right_shoulder_rot", -0.4), ("right_elbow", 1.3)):
+        if dof in m.dof_names:
+            pose[m.dof(dof)] = value
+    joints = joints_from_poses(m, pose[None])[0]
+    got = arm_angles(m, pose, "right", *(joints[J[f"right_{j}"]] for j in ("shoulder", "elbow", "wrist")))
+    want = [pose[m.dof(f"right_{n}")] for n in ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")]
+    np.testing.assert_allclose(got, want, atol=1e-9)
 
 
 def test_pose_from_joints_wraps_heading_and_checks_input():

@@ -194,10 +194,10 @@ class PoseEstimator:
             self.filter.particles = self.filter.particles + drift
             self._previous = current.copy()
         if self.proposals > 0 and current is not None:
-            self._propose(current, observation.points, active)
+            self._propose(current, observation, active)
         return self.filter.step(active=active, diffusion_scale=diffusion_scale)
 
-    def _propose(self, current: np.ndarray, points: np.ndarray, active: np.ndarray | None) -> None:
+    def _propose(self, current: np.ndarray, observation: Observation, active: np.ndarray | None) -> None:
         """Set the arm DOFs of a random share of the particles to each arm proposal (arms
         of the model only, and only where every DOF of the arm is active)."""
         model = self.problem.model
@@ -205,7 +205,7 @@ class PoseEstimator:
             return
         count = int(round(self.proposals * self.filter.num_particles))
         particles = self.filter.particles.copy()
-        proposals = arm_proposals(model, current, points)
+        proposals = arm_proposals(model, current, observation)
         if self.problem.walking is not None and self.problem.heading_dof is not None:
             proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
         for dofs, values in proposals:

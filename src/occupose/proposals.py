@@ -10,7 +10,7 @@ within reach of a shoulder (nearer that shoulder than the other). When an arm ha
 is taken as the hand, the arm reaches for it (:func:`reach_towards`: straight when the
 hand is out of reach, else bent with the elbow where the points are), and the arm's
 joint angles of that pose (the analytic inverse kinematics of
-:func:`occupose.body.pose_from_joints`) replace those of a share of the particles before
+:func:`occupose.body.arm_angles`) replace those of a share of the particles before
 the filter's step. The filter's weights decide: a proposal that does not explain the
 points better dies at the first resampling.
 """
@@ -20,9 +20,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from occupose.body import BodyModel, capsules_from_poses, joints_from_poses, pose_from_joints
+from occupose.body import BodyModel, arm_angles, capsules_from_poses, joints_from_poses
 from occupose.joints import JOINT_INDEX
-from occupose.likelihood import point_distances
+from occupose.likelihood import Observation, point_distances
 
 #: Default distance, metres, beyond which a point is not explained by the estimate.
 UNEXPLAINED = 0.05
@@ -42,18 +42,20 @@ def arm_dofs(model: BodyModel, side: str) -> np.ndarray:
     return np.array([model.dof_names.index(f"{side}_{name}") for name in ARM_DOFS], np.int64)
 
 
-def arm_proposals(model: BodyModel, pose: np.ndarray, points: np.ndarray, *, unexplained: float = UNEXPLAINED,
-                  min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
+def arm_proposals(model: BodyModel, pose: np.ndarray, points: np.ndarray | Observation, *,
+                  unexplained: float = UNEXPLAINED, min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
     """The arm poses that the points unexplained by ``pose`` suggest.
 
-    model : the body model; pose : (D,) the current estimate; points : (N, 3) world metres
+    model : the body model; pose : (D,) the current estimate; points : (N, 3) world
+    metres, or the frame's Observation (its blocks of points are reused)
     Returns a list of (dofs (n,) int64, values (n,) float64), one per arm with evidence.
     """
-    points = np.asarray(points, float)
+    observed = points
+    points = observed.points if isinstance(observed, Observation) else np.asarray(observed, float)
     if len(points) < min_points:
         return []
     a, b = capsules_from_poses(model, pose[None])
-    distance, _ = point_distances(a, b, model.capsule_radii, points)
+    distance, _ = point_distances(a, b, model.capsule_radii, observed)
     loose = points[distance[0] > unexplained]
     if len(loose) < min_points:
         return []
@@ -71,13 +73,9 @@ def arm_proposals(model: BodyModel, pose: np.ndarray, points: np.ndarray, *, une
             continue
         mine = np.flatnonzero(mine)
         hand = loose[mine[np.argsort(reach[mine])[int(0.9 * (len(mine) - 1))]]]
-        target = joints.copy()
         within = points[np.linalg.norm(points - shoulder, axis=1) < REACH * (upper + fore)]
-        target[JOINT_INDEX[f"{side}_elbow"]], target[JOINT_INDEX[f"{side}_wrist"]] = reach_towards(
-            shoulder, hand, upper, fore, within)
-        target[~model.reported_joints] = np.nan
-        dofs = arm_dofs(model, side)
-        proposals.append((dofs, pose_from_joints(model, target, refine=False)[dofs]))
+        elbow, wrist = reach_towards(shoulder, hand, upper, fore, within)
+        proposals.append((arm_dofs(model, side), arm_angles(model, pose, side, shoulder, elbow, wrist)))
     return proposals
 
 

@@ -128,6 +128,26 @@ def _inside(model: BodyModel, pose: np.ndarray) -> np.ndarray:
     return pose
 
 
+def arm_angles(model: BodyModel, pose: np.ndarray, side: str, shoulder, elbow, wrist) -> np.ndarray:
+    """(4,) shoulder flex, abd, rot and elbow of ``side``'s ("left" or "right") arm that
+    point it from ``shoulder`` through ``elbow`` to ``wrist`` ((3,) world metres), in the
+    torso of ``pose`` (D,): the analytic solution of :func:`pose_from_joints` for one arm
+    (the rest of the pose kept), clipped just inside the limits as pose_from_joints does
+    (arm proposals put exactly on a limit tracked measurably worse: 10.7 against 7.0 cm on
+    mocap no_occlusion)."""
+    names = model.dof_names
+    torso = _rot(2, pose[names.index("heading")]) @ _rot(1, pose[names.index("trunk_lean")])
+    if "trunk_side" in names:
+        torso = torso @ _rot(0, -pose[names.index("trunk_side")])
+    dofs = [names.index(f"{side}_{name}") for name in ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")]
+    s = 1.0 if side == "left" else -1.0
+    angles = _limb(torso, np.asarray(shoulder, float), np.asarray(elbow, float), np.asarray(wrist, float), s,
+                   leg=False, limits=model.limits[dofs[:2]])
+    lo, hi = model.limits[dofs, 0], model.limits[dofs, 1]
+    margin = 1e-6 * (hi - lo)
+    return np.clip(angles, lo + margin, hi - margin)
+
+
 def pose_from_joints(model: BodyModel, joints, *, refine: bool = True) -> np.ndarray:
     """A pose of ``model`` whose canonical joints match ``joints``.
 

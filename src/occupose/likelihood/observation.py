@@ -7,10 +7,12 @@ synthetic renderer's person image) and handed to every likelihood of that frame.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from occupose.camera import Camera, points_from_depth
+from occupose.likelihood._capsules import PointBlocks, blocked_points
 
 #: Share of the mask's bounding box added on each side when a View's ``roi`` is not given
 #: (room for particles whose limbs reach beyond the observed silhouette).
@@ -115,6 +117,12 @@ class Observation:
             raise ValueError("views must be a sequence of occupose.likelihood.View")
         object.__setattr__(self, "points", np.ascontiguousarray(points))
         object.__setattr__(self, "views", views)
+
+    @cached_property
+    def blocks(self) -> PointBlocks:
+        """The points in spatially compact blocks for the points kernels, made once (the
+        points likelihood and the arm proposals of a frame share them)."""
+        return blocked_points(self.points)
 
 
 def observation_from_views(views, max_points: int = 2000) -> Observation:

@@ -32,16 +32,20 @@ def point_distances(a, b, radii, points) -> tuple[np.ndarray, np.ndarray]:
     """Distance from each point to the nearest capsule surface, per particle.
 
     a, b : (P, C, 3) float, metres, world: round-cone ends; radii : (C, 2) float, metres
-    points : (N, 3) float, metres, world
+    points : (N, 3) float, metres, world, or an Observation (whose blocks of points are
+        reused)
     Returns distance (P, N) float32, metres (absolute distance to the round cone's
     surface; float32, exact to about a micrometre) and capsule (P, N) int32, the index of
     the nearest capsule (the first one on ties).
     """
     a, b, radii, _, _ = check_capsules(a, b, radii, np.zeros(np.shape(radii)[0], np.int64), 1)
-    points = np.asarray(points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
-        raise ValueError(f"points must be a finite (N, 3) array, got shape {points.shape}")
-    blocks = blocked_points(points)
+    if isinstance(points, Observation):
+        blocks = points.blocks
+    else:
+        points = np.asarray(points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
+            raise ValueError(f"points must be a finite (N, 3) array, got shape {points.shape}")
+        blocks = blocked_points(points)
     blocked_distance = np.empty((a.shape[0], len(blocks.px)), np.float32)
     blocked_capsule = np.empty((a.shape[0], len(blocks.px)), np.int32)
     _kernels.nearest_capsules(a, b, radii, *blocks.kernel_args, blocked_distance, blocked_capsule)
@@ -62,7 +66,7 @@ class PointsLikelihood:
             raise ValueError("the points likelihood needs an observation with at least one point, got none")
         self.scale = check_positive(scale, "scale")
         self.num_points = len(observation.points)
-        self._blocks = blocked_points(observation.points)
+        self._blocks = observation.blocks
 
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """(P, K) float64 log-likelihoods of particles with capsules a, b (P, C, 3) metres,
