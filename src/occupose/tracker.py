@@ -553,10 +553,13 @@ class Tracker:
         active = scale = None
         centroid = np.asarray(centroid, float)
         if person.lost:  # back after being gone or suspended: start again at the blob
+            # The particles are where the last estimate left them, not where the pose was
+            # carried since: shift them from the estimate.
             offset = np.zeros(person.model.num_dofs)
-            offset[:2] = centroid[:2] + person.anchor - person.pose[:2]
+            offset[:2] = centroid[:2] + person.anchor - person.estimator.filter.estimate[:2]
             person.estimator.shift(offset)
-            person.pose = person.pose + offset
+            person.pose = person.pose.copy()
+            person.pose[:2] = centroid[:2] + person.anchor
             person.centroid, person.lost = centroid, False
             person.path = []  # its way over the gap is unknown: no walking prior until it has walked again
         moved = person.pose.copy()
