@@ -47,7 +47,7 @@ def test_arm_dofs_are_shoulder_and_elbow_of_that_side():
 
 def test_a_lost_arm_is_proposed_where_its_points_are(raised):
     model, hanging, pose, points = raised
-    proposals = arm_proposals(model, hanging, points)
+    proposals = arm_proposals(model, hanging, Observation(points, ()))
     assert len(proposals) == 1  # the left arm is where its points are
     dofs, values = proposals[0]
     assert np.array_equal(dofs, arm_dofs(model, "right"))
@@ -78,8 +78,8 @@ def test_reach_towards_bends_the_arm_where_its_points_are_and_straightens_it_out
 
 def test_no_proposal_when_the_estimate_explains_the_points(raised):
     model, _, pose, points = raised
-    assert arm_proposals(model, pose, points) == []
-    assert arm_proposals(model, pose, points[:5]) == []
+    assert arm_proposals(model, pose, Observation(points, ())) == []
+    assert arm_proposals(model, pose, Observation(points[:5], ())) == []
 
 
 def _track_static(model, start, points, proposals, active=None, frames=6):

@@ -156,7 +156,7 @@ class PoseEstimator:
         self.filter = make_filter(filter, problem, particles, rng, **filter_options)
         self.velocity_damping = velocity_damping
         self.proposals = proposals
-        self._rng = rng
+        self._has_arms = all(f"{side}_{name}" in problem.model.dof_names for side in SIDES for name in ARM_DOFS)
         self._previous = None
 
     def initialise(self, pose: np.ndarray, spread: float | np.ndarray = 0.0) -> None:
@@ -198,20 +198,19 @@ class PoseEstimator:
         return self.filter.step(active=active, diffusion_scale=diffusion_scale)
 
     def _propose(self, current: np.ndarray, observation: Observation, active: np.ndarray | None) -> None:
-        """Set the arm DOFs of a random share of the particles to each arm proposal (arms
-        of the model only, and only where every DOF of the arm is active)."""
-        model = self.problem.model
-        if not all(f"{side}_{name}" in model.dof_names for side in SIDES for name in ARM_DOFS):
+        """Set the DOFs of a random share of the particles to each arm proposal (models with
+        arms) and to the heading of the way walked, where every DOF set is active."""
+        proposals = arm_proposals(self.problem.model, current, observation) if self._has_arms else []
+        if self.problem.walking is not None and self.problem.heading_dof is not None:
+            proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
+        proposals = [(dofs, values) for dofs, values in proposals if active is None or active[dofs].all()]
+        if not proposals:
             return
         count = int(round(self.proposals * self.filter.num_particles))
         particles = self.filter.particles.copy()
-        proposals = arm_proposals(model, current, observation)
-        if self.problem.walking is not None and self.problem.heading_dof is not None:
-            proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
         for dofs, values in proposals:
-            if active is None or active[dofs].all():
-                chosen = self._rng.choice(len(particles), count, replace=False)
-                particles[np.ix_(chosen, dofs)] = values
+            chosen = self.filter.rng.choice(len(particles), count, replace=False)
+            particles[np.ix_(chosen, dofs)] = values
         self.filter.particles = particles
 
     def joints(self, pose: np.ndarray) -> np.ndarray:

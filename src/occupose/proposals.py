@@ -42,20 +42,19 @@ def arm_dofs(model: BodyModel, side: str) -> np.ndarray:
     return np.array([model.dof_names.index(f"{side}_{name}") for name in ARM_DOFS], np.int64)
 
 
-def arm_proposals(model: BodyModel, pose: np.ndarray, points: np.ndarray | Observation, *,
+def arm_proposals(model: BodyModel, pose: np.ndarray, observation: Observation, *,
                   unexplained: float = UNEXPLAINED, min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
     """The arm poses that the points unexplained by ``pose`` suggest.
 
-    model : the body model; pose : (D,) the current estimate; points : (N, 3) world
-    metres, or the frame's Observation (its blocks of points are reused)
+    model : the body model; pose : (D,) the current estimate; observation : the frame's
+    Observation (its points, world metres, and their blocks, shared with the likelihood)
     Returns a list of (dofs (n,) int64, values (n,) float64), one per arm with evidence.
     """
-    observed = points
-    points = observed.points if isinstance(observed, Observation) else np.asarray(observed, float)
+    points = observation.points
     if len(points) < min_points:
         return []
     a, b = capsules_from_poses(model, pose[None])
-    distance, _ = point_distances(a, b, model.capsule_radii, observed)
+    distance, _ = point_distances(a, b, model.capsule_radii, observation)
     loose = points[distance[0] > unexplained]
     if len(loose) < min_points:
         return []

@@ -75,6 +75,11 @@ def _limb(parent: np.ndarray, root, mid, end, s: float, leg: bool, limits: np.nd
     return flex, abd, roll, bend
 
 
+def _torso_rotation(heading: float, lean: float, side: float) -> np.ndarray:
+    """Rotation (3, 3) of the torso frame for the root's heading, trunk_lean and trunk_side."""
+    return _rot(2, heading) @ _rot(1, lean) @ _rot(0, -side)
+
+
 def _analytic(model: BodyModel, joints: np.ndarray) -> np.ndarray:
     pose = np.zeros(model.num_dofs)
     names = model.dof_names
@@ -92,9 +97,7 @@ def _analytic(model: BodyModel, joints: np.ndarray) -> np.ndarray:
         put(name, value)
     if "trunk_side" in names:
         put("trunk_side", side)
-        torso = _rot(2, heading) @ _rot(1, lean) @ _rot(0, -side)
-    else:
-        torso = _rot(2, heading) @ _rot(1, lean)
+    torso = _torso_rotation(heading, lean, side if "trunk_side" in names else 0.0)
     head = torso.T @ _unit(joints[J["head"]] - joints[J["neck"]])
     put("neck_flex", math.atan2(head[0], head[2]))
     put("neck_side", math.asin(float(np.clip(head[1], -1.0, 1.0))))
@@ -136,9 +139,8 @@ def arm_angles(model: BodyModel, pose: np.ndarray, side: str, shoulder, elbow, w
     (arm proposals put exactly on a limit tracked measurably worse: 10.7 against 7.0 cm on
     mocap no_occlusion)."""
     names = model.dof_names
-    torso = _rot(2, pose[names.index("heading")]) @ _rot(1, pose[names.index("trunk_lean")])
-    if "trunk_side" in names:
-        torso = torso @ _rot(0, -pose[names.index("trunk_side")])
+    torso = _torso_rotation(pose[names.index("heading")], pose[names.index("trunk_lean")],
+                            pose[names.index("trunk_side")] if "trunk_side" in names else 0.0)
     dofs = [names.index(f"{side}_{name}") for name in ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")]
     s = 1.0 if side == "left" else -1.0
     angles = _limb(torso, np.asarray(shoulder, float), np.asarray(elbow, float), np.asarray(wrist, float), s,
