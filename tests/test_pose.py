@@ -27,11 +27,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from occupose.body import body_model, joints_from_poses, pose_from_joints, standing_pose
+from occupose.body import body_model, capsules_from_poses, joints_from_poses, pose_from_joints, standing_pose
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import View, observation_from_views
 from occupose.metrics import frame_errors, is_fail, joint_errors, table_row
-from occupose.pose import PoseEstimator, PoseProblem, default_stages
+from occupose.pose import FLOOR_COST, FLOOR_SLACK, PoseEstimator, PoseProblem, default_stages
 from occupose.synth.generate import frames, person_observations
 from occupose.synth.motion import dims_from_joints
 from occupose.synth.scenarios import build_scenario
@@ -133,6 +133,29 @@ def test_walking_costs_facing_away_from_the_way_walked_on_the_heading_part(walk)
     torso = model.part_names.index("torso")
     np.testing.assert_allclose((walking - free)[:, torso], [0.0, -1.0, -2.0], atol=1e-9)
     assert np.all(np.delete(walking - free, torso, axis=1) == 0.0)
+
+
+def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
+    gt, observations = walk
+    model = body_model("full", dims=dims_from_joints(gt))
+    problem = PoseProblem(model)
+    free = PoseProblem(model, floor=None)
+    for p in (problem, free):
+        p.set_observation(observations[10])
+    pose = pose_from_joints(model, gt[10])
+    sunk = pose.copy()
+    sunk[model.dof("z")] -= 0.2
+    values, without = problem.log_likelihood(np.array([pose, sunk])), free.log_likelihood(np.array([pose, sunk]))
+    assert np.array_equal(values[0], without[0])  # standing: no part below the floor
+    # the shins' lowest surface point (the ankle end's sphere), 20 cm lower
+    a, b = capsules_from_poses(model, sunk[None])
+    lowest = np.minimum(a[0, :, 2] - model.capsule_radii[:, 0], b[0, :, 2] - model.capsule_radii[:, 1])
+    cost = FLOOR_COST * np.maximum(-FLOOR_SLACK - lowest, 0.0)
+    expected = np.bincount(model.capsule_part, weights=cost, minlength=len(model.part_names))
+    assert {model.part_names[i] for i in np.flatnonzero(expected)} == {"left_shin", "right_shin"}
+    np.testing.assert_allclose(without[1] - values[1], expected, atol=1e-9)
+    with pytest.raises(ValueError, match="floor must be a finite height"):
+        PoseProblem(model, floor=float("nan"))
 
 
 def test_part_weights_chain_weighs_each_group_by_its_chain_to_the_root():

@@ -18,6 +18,12 @@ from occupose.proposals import ARM_DOFS, SIDES, arm_proposals
 
 #: Default share of the particles given to the arm proposals (see PoseEstimator).
 PROPOSAL_SHARE = 0.1
+#: The floor term (see PoseProblem): a part whose surface reaches more than FLOOR_SLACK
+#: metres below the floor costs FLOOR_COST nats per metre beyond that. The camera sees the
+#: floor, so a limb pushed through it is "hidden behind the floor" and the depth terms do
+#: not object: without this a leg left with no points of its own sinks into the floor.
+FLOOR_SLACK = 0.03
+FLOOR_COST = 20.0
 
 
 class PoseProblem:
@@ -31,13 +37,19 @@ class PoseProblem:
         then head and arms, then legs (the model's own partitions when it has no legs)
     part_weights : how the part-based filter weights each of ``model.weight_groups``, a
         key of :data:`PART_WEIGHTS` (see :func:`chain_weight_groups`)
+    floor : height of the floor, world metres (DESIGN: z = 0), below which a part costs
+        :data:`FLOOR_COST` nats per metre; None for no floor
     """
 
     def __init__(self, model: BodyModel, likelihood: str = "points+free", *, fps: float = 30.0,
                  diffusion: np.ndarray | None = None, likelihood_options: dict | None = None,
-                 stages: list[list[int]] | None = None, part_weights: str = "chain"):
+                 stages: list[list[int]] | None = None, part_weights: str = "chain",
+                 floor: float | None = 0.0):
         if part_weights not in PART_WEIGHTS:
             raise ValueError(f"unknown part_weights {part_weights!r}; valid names: {', '.join(PART_WEIGHTS)}")
+        if floor is not None and not np.isfinite(floor):
+            raise ValueError(f"floor must be a finite height in metres or None, got {floor!r}")
+        self.floor = floor
         self.model = model
         self.likelihood_name = likelihood
         self.likelihood_options = dict(likelihood_options or {})
@@ -75,6 +87,11 @@ class PoseProblem:
         a, b = capsules_from_poses(self.model, poses)
         out = self._likelihood.evaluate(a, b, self.model.capsule_radii, self.model.capsule_part,
                                         len(self.model.part_names))
+        if self.floor is not None:
+            lowest = np.minimum(a[..., 2] - self.model.capsule_radii[:, 0], b[..., 2] - self.model.capsule_radii[:, 1])
+            sunk = np.maximum(self.floor - FLOOR_SLACK - lowest, 0.0)
+            if sunk.any():
+                np.add.at(out.T, self.model.capsule_part, -FLOOR_COST * sunk.T)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
