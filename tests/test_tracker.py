@@ -322,3 +322,22 @@ def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
     assert abs(direction) == pytest.approx(np.pi) and weight == pytest.approx(WALK_PRIOR * (0.6 - WALK_FROM) / WALK_RAMP)
     person.path = [np.array([0.01 * i, 0.0]) for i in range(WALK_FRAMES)]  # 0.3 m/s: standing, swaying
     assert person.walking() is None
+
+
+def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
+    model = body_model("full")
+    person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.centroid = pose, np.array([0.0, 0.0, 1.0])
+    person.path = [np.array([0.04 * i, 0.0]) for i in range(WALK_FRAMES)]  # 1.2 m/s along +x
+    person.lost = True
+    person.come_back(np.array([2.0, 1.0, 1.0]))  # back at another blob after a gap
+    assert not person.lost
+    np.testing.assert_allclose(person.pose[:2], [2.0, 1.0])
+    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [2.0, 1.0])
+    np.testing.assert_allclose(person.path[-1], [2.0, 1.0])  # the jump is no step: same way, same speed
+    direction, weight = person.walking()
+    assert direction == pytest.approx(0.0) and weight == pytest.approx(WALK_PRIOR)
+    person.carry()  # hidden again at once: carried on along +x
+    np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])

@@ -268,6 +268,21 @@ class _Person:
             self.pose[:2] += step
         self.lost = True
 
+    def come_back(self, centroid: np.ndarray) -> None:
+        """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
+        plus the anchor. The particles are where the last estimate left them, not where
+        the pose was carried since, so they are shifted from the estimate. The path is moved
+        along (the jump onto the blob is no step of the person's): the way it walked before
+        goes on, so a person hidden again soon after is carried on that way."""
+        offset = np.zeros(self.model.num_dofs)
+        offset[:2] = centroid[:2] + self.anchor - self.estimator.filter.estimate[:2]
+        self.estimator.shift(offset)
+        self.pose = self.pose.copy()
+        self.pose[:2] = centroid[:2] + self.anchor
+        self.centroid, self.lost = centroid, False
+        if self.path:
+            self.path = [p + (self.pose[:2] - self.path[-1]) for p in self.path]
+
     def estimate(self, fresh: bool) -> PersonEstimate:
         joints = joints_of(self.model, self.pose)
         visible = np.array([fresh and bool(len(p)) and bool(self.part_visible[p].all()) for p in self.joint_parts])
@@ -552,16 +567,8 @@ class Tracker:
     def _step(self, tid, person: _Person, observation, depths, assigned, centroid) -> PersonEstimate:
         active = scale = None
         centroid = np.asarray(centroid, float)
-        if person.lost:  # back after being gone or suspended: start again at the blob
-            # The particles are where the last estimate left them, not where the pose was
-            # carried since: shift them from the estimate.
-            offset = np.zeros(person.model.num_dofs)
-            offset[:2] = centroid[:2] + person.anchor - person.estimator.filter.estimate[:2]
-            person.estimator.shift(offset)
-            person.pose = person.pose.copy()
-            person.pose[:2] = centroid[:2] + person.anchor
-            person.centroid, person.lost = centroid, False
-            person.path = []  # its way over the gap is unknown: no walking prior until it has walked again
+        if person.lost:
+            person.come_back(centroid)
         moved = person.pose.copy()
         moved[:2] += centroid[:2] - person.centroid[:2]
         person.centroid = centroid
