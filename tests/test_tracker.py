@@ -197,6 +197,14 @@ def test_planted_legs_keep_the_feet_on_the_floor():
     standing = planted_legs(model, pose, ["left"])
     assert standing[model.dof_names.index("left_knee")] < 0.15  # a standing leg stays straight
     assert np.array_equal(standing[model.dof_names.index("right_knee")], pose[model.dof_names.index("right_knee")])
+    # a seen thigh (seated, forward) over a hidden shin last seen folded back: only the knee moves
+    folded = fixed.copy()
+    folded[model.dof_names.index("right_knee")] = 2.1
+    shin = planted_legs(model, folded, [], ["right"])
+    changed = np.flatnonzero(shin != folded)
+    assert [model.dof_names[i] for i in changed] == ["right_knee"]
+    ankle = joints_from_poses(model, shin[None])[0, JOINT_INDEX["right_ankle"]]
+    assert abs(ankle[2] - model.dims.ankle_height) < 0.03
 
 
 # ------------------------------------------------------------------------------ the command line

@@ -252,24 +252,28 @@ def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsu
     return per_part > 0.5 * np.maximum(total, 1)
 
 
-def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str]) -> np.ndarray:
+def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins: Sequence[str] = ()) -> np.ndarray:
     """``pose`` (D,) with the legs of ``sides`` ("left", "right") placed with their feet on
     the floor: hip flexion and knee bend (abduction and rotation 0) that put the ankle at
-    the model's ankle height, the least bent such leg, the shin near vertical.
+    the model's ankle height, the least bent such leg, the shin near vertical; for the
+    ``shins`` (legs whose thigh is seen, its shin hidden) only the knee bend, the thigh
+    left as it is.
 
     For legs hidden behind furniture: the paper keeps a hidden part's last seen
     configuration relative to its parent, so straight legs sink through the floor when
-    the person sits down behind a table; feet stay on the floor while standing, sitting
-    down and getting up, so this is where hidden legs are most likely.
+    the person sits down behind a table (and a shin last seen folded stays folded under a
+    thigh that moves on); feet stay on the floor while standing, sitting down and getting
+    up, so this is where hidden legs are most likely.
     """
     pose = np.array(pose, float)
-    hip, knee = np.meshgrid(PLANT_HIP, PLANT_KNEE, indexing="ij")
-    hip, knee = hip.reshape(-1), knee.reshape(-1)
-    for side in sides:
+    grid = np.meshgrid(PLANT_HIP, PLANT_KNEE, indexing="ij")
+    for side, whole in [(side, True) for side in sides] + [(side, False) for side in shins]:
         dofs = [model.dof_names.index(f"{side}_hip_{n}") for n in ("flex", "abd", "rot")]
         bend = model.dof_names.index(f"{side}_knee")
-        candidates = np.repeat(pose[None], len(hip), axis=0)
-        candidates[:, dofs] = np.stack([hip, np.zeros_like(hip), np.zeros_like(hip)], axis=1)
+        hip, knee = (grid[0].reshape(-1), grid[1].reshape(-1)) if whole else (pose[dofs[0]], PLANT_KNEE)
+        candidates = np.repeat(pose[None], len(knee), axis=0)
+        if whole:
+            candidates[:, dofs] = np.stack([hip, np.zeros_like(hip), np.zeros_like(hip)], axis=1)
         candidates[:, bend] = knee
         ankle = joints_from_poses(model, candidates)[:, JOINT_INDEX[f"{side}_ankle"]]
         cost = np.abs(ankle[:, 2] - model.dims.ankle_height) + 0.05 * np.abs(knee - hip) + 0.01 * knee

@@ -594,11 +594,12 @@ class Tracker:
         if person.occlusion is not None:
             person.occlusion.remember(pose)
             pose = person.occlusion.with_memory(pose)
-            hidden_legs = [side for side in ("left", "right")
-                           if f"{side}_thigh" in person.model.part_names
-                           and not person.part_visible[person.model.part_names.index(f"{side}_thigh")]]
-            if hidden_legs:
-                pose = planted_legs(person.model, pose, hidden_legs)
+            names = person.model.part_names
+            hidden = {part: not person.part_visible[names.index(part)] for part in names}
+            legs = [side for side in ("left", "right") if hidden[f"{side}_thigh"]]
+            shins = [side for side in ("left", "right") if hidden[f"{side}_shin"] and not hidden[f"{side}_thigh"]]
+            if legs or shins:
+                pose = planted_legs(person.model, pose, legs, shins)
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
         person.settle(pose)
         person.face_the_way_walked()
