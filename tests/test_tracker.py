@@ -297,26 +297,53 @@ def test_with_two_cameras_one_that_sees_the_whole_person_is_enough_to_start():
     assert tracker._at_border(observation(none, none))
 
 
-def test_a_blob_next_to_a_tracked_person_does_not_start_another(walk, monkeypatch):
-    """A second blob 0.3 m from a tracked person's pelvis (a piece of the body split off
-    its blob) is kept from starting a person; one 1.5 m away starts."""
+def _tries_to_start(tracking, monkeypatch, observation, offset: float) -> bool:
+    """Whether a blob track 99 holding ``observation``, its centroid ``offset`` metres
+    beside person 1's pelvis, starts a person after INIT_FRAMES tries."""
+    tracker, depths = tracking
+    person, tid = tracker.people[1], 99
+    states = dict(tracker.blobs.states)
+    monkeypatch.setattr(type(tracker.blobs), "states", property(lambda self: states))
+    states[tid] = replace(states[1], centroid=np.array([*(person.pose[:2] + [offset, 0.0]), 1.0]))
+    tracker._pending.pop(tid, None)
+    blob = SimpleNamespace(top=1.8, centroid=states[tid].centroid)  # its cells reach 1.8 m
+    started = [tracker._start(tid, observation, depths, tracker.last_assigned, blob)
+               for _ in range(INIT_FRAMES)]
+    return started[-1] is not None
+
+
+@pytest.fixture
+def tracking(walk):
+    """(a tracker that has tracked the walk's first 12 frames (person 1), the 12th frame's depths)."""
     scenario, rendered = walk
     tracker = Tracker(scenario.cameras, scenario.fps, "ours", seed=0)
     for f in rendered[:12]:
         out = tracker.update(f.depth)
     assert list(out) == [1]
-    person = tracker.people[1]
-    tid, observation = 99, tracker._previous[1]
-    states = dict(tracker.blobs.states)  # a blob track 99 beside the person's
-    monkeypatch.setattr(type(tracker.blobs), "states", property(lambda self: states))
-    for offset, starts in ((0.3, False), (1.5, True)):
-        states[tid] = replace(states[1], centroid=np.array([*(person.pose[:2] + [offset, 0.0]), 1.0]))
-        tracker._pending.pop(tid, None)
-        blob = SimpleNamespace(top=1.8, centroid=states[tid].centroid)  # person-like
-        started = [tracker._start(tid, observation, rendered[11].depth, tracker.last_assigned, blob)
-                   for _ in range(INIT_FRAMES)]
-        assert (started[-1] is not None) == starts
-        assert tid in tracker._fragments  # since the first, near offset
+    return tracker, rendered[11].depth
+
+
+def test_a_blob_next_to_a_tracked_person_does_not_start_another(tracking, monkeypatch):
+    """A second blob 0.3 m from a tracked person's pelvis (a piece of the body split off
+    its blob) is kept from starting a person; one 1.5 m away starts."""
+    tracker = tracking[0]
+    observation = tracker._previous[1]
+    assert not _tries_to_start(tracking, monkeypatch, observation, 0.3)
+    assert 99 in tracker._fragments
+    assert _tries_to_start(tracking, monkeypatch, observation, 1.5)
+    assert 99 in tracker._fragments  # since the first, near offset
+
+
+def test_a_blob_whose_own_points_stay_below_a_seated_head_does_not_start(tracking, monkeypatch):
+    """A chair put down beside its carrier: the blob's cells reach the carrier's height, the
+    pixels it is given (the carrier's go to the carrier) stay below 1 m."""
+    observation = tracking[0]._previous[1]
+    low = {c: observation.camera_points[c][:, 2] < 0.9 for c in observation.camera_points}
+    chair = GridObservation(99, {c: observation.pixels[c][low[c]] for c in low},
+                            {c: observation.camera_points[c][low[c]] for c in low})
+    assert len(chair.points) > 1000
+    assert not _tries_to_start(tracking, monkeypatch, chair, 1.5)
+    assert _tries_to_start(tracking, monkeypatch, observation, 1.5)  # the whole body does
 
 
 def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():

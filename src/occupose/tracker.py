@@ -49,6 +49,7 @@ from occupose.body import (
     joints_from_poses,
     pose_from_joints,
 )
+from occupose.body.size import TOP_RANK
 from occupose.camera import Camera
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
@@ -109,7 +110,10 @@ METHODS: dict[str, Method] = {
 #: A camera whose optical axis points down more steeply than this (radians below the
 #: horizontal) is a ceiling camera: ``model="auto"`` picks the upper-body model.
 STEEP_DOWN = np.deg2rad(60.0)
-#: A blob starts a person once its top is at least this high, metres (a seated adult's head),
+#: A blob starts a person once its own points (the pixels given to it, not those of the
+#: people beside it) reach at least this high, metres (a seated adult's head; the
+#: TOP_RANK-th highest point, as for the stature): a chair put down beside its carrier
+#: shares the carrier's blob track but not the carrier's pixels,
 MIN_INIT_TOP = 1.0
 #: it has at least this many observed points,
 MIN_INIT_POINTS = 200
@@ -506,7 +510,8 @@ class Tracker:
         """A new person from its blob, or None while the blob has not been person-like for
         INIT_FRAMES frames."""
         points = observation.points
-        if blob.top < MIN_INIT_TOP or len(points) < MIN_INIT_POINTS or self._at_border(observation):
+        if (len(points) < MIN_INIT_POINTS or np.partition(points[:, 2], -TOP_RANK)[-TOP_RANK] < MIN_INIT_TOP
+                or self._at_border(observation)):
             self._pending.pop(tid, None)
             return None
         centroid = self.blobs.states[tid].centroid[:2]
