@@ -16,14 +16,15 @@ A frame:
 3. every tracked blob's pixels go to its person; where people touch, each pixel goes
    to the nearest predicted body (exclusion principle; a new person's body is made of
    its previous points, see :func:`occupose.grid.observation.predicted_from_tracks`);
-4. per person: a new track starts once its blob has been tall enough and fully in view
-   for a few frames (body size from their points, a search over headings facing where
+4. per person: a new track starts once its blob's own points have been tall enough and
+   fully in view for a few frames (body size from their points, a search over headings facing where
    it walks or the camera, standing or sitting); a known one first runs the occlusion
    check (its previous estimate moved to the blob's new centre of mass), then the filter
-   on the visible subtree; hidden legs are placed with their feet on the floor;
+   on the visible subtree; hidden legs (and hidden shins under seen thighs) are placed
+   with their feet on the floor;
 5. a person whose torso is hidden is kept (suspended) and moved with its blob; one whose
    blob is gone is kept and carried at its last velocity; either is placed back on its
-   blob when seen again (a new blob track near it is its); it ends when its blob has been
+   blob when seen again, keeping the way it walked (a new blob track near it is its); it ends when its blob has been
    gone for longer than ``max_gap_s``.
 
 With ``upcoming`` frames, step 1 of the next frame runs on a second thread during step 4.
