@@ -17,15 +17,15 @@ A frame:
    to the nearest predicted body (exclusion principle; a new person's body is made of
    its previous points, see :func:`occupose.grid.observation.predicted_from_tracks`);
 4. per person: a new track starts once its blob's own points have been tall enough and
-   fully in view for a few frames (body size from their points, a search over headings facing where
-   it walks or the camera, standing or sitting); a known one first runs the occlusion
-   check (its previous estimate moved to the blob's new centre of mass), then the filter
-   on the visible subtree; hidden legs (and hidden shins under seen thighs) are placed
+   fully in view for a few frames (body size from their points, a search over headings
+   facing where it walks or the camera, standing or sitting); a known one first runs the
+   occlusion check (its previous estimate moved to the blob's new centre of mass), then
+   the filter on the visible subtree; hidden legs (and hidden shins under seen thighs) are placed
    with their feet on the floor;
 5. a person whose torso is hidden is kept (suspended) and moved with its blob; one whose
    blob is gone is kept and carried at its last velocity; either is placed back on its
-   blob when seen again, keeping the way it walked (a new blob track near it is its); it ends when its blob has been
-   gone for longer than ``max_gap_s``.
+   blob when seen again, keeping the way it walked (a new blob track near it is its); it
+   ends when its blob has been gone for longer than ``max_gap_s``.
 
 With ``upcoming`` frames, step 1 of the next frame runs on a second thread during step 4.
 
@@ -50,7 +50,7 @@ from occupose.body import (
     joints_from_poses,
     pose_from_joints,
 )
-from occupose.body.size import TOP_RANK
+from occupose.body.size import top_height
 from occupose.camera import Camera
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
@@ -112,8 +112,8 @@ METHODS: dict[str, Method] = {
 #: horizontal) is a ceiling camera: ``model="auto"`` picks the upper-body model.
 STEEP_DOWN = np.deg2rad(60.0)
 #: A blob starts a person once its own points (the pixels given to it, not those of the
-#: people beside it) reach at least this high, metres (a seated adult's head; the
-#: TOP_RANK-th highest point, as for the stature): a chair put down beside its carrier
+#: people beside it) reach at least this high, metres (a seated adult's head; their top
+#: as for the stature, occupose.body.size.top_height): a chair put down beside its carrier
 #: shares the carrier's blob track but not the carrier's pixels,
 MIN_INIT_TOP = 1.0
 #: it has at least this many observed points,
@@ -241,7 +241,7 @@ class _Person:
                 or self.estimates > START_CHECK_S * self.fps):
             return
         velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps
-        heading = self.model.dof_names.index("heading")
+        heading = self.problem.heading_dof
         facing = self.pose[heading]
         off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
         if np.hypot(*velocity) > WALKING_SPEED and abs(off) > BACKWARDS:
@@ -511,8 +511,7 @@ class Tracker:
         """A new person from its blob, or None while the blob has not been person-like for
         INIT_FRAMES frames."""
         points = observation.points
-        if (len(points) < MIN_INIT_POINTS or np.partition(points[:, 2], -TOP_RANK)[-TOP_RANK] < MIN_INIT_TOP
-                or self._at_border(observation)):
+        if len(points) < MIN_INIT_POINTS or top_height(points[:, 2]) < MIN_INIT_TOP or self._at_border(observation):
             self._pending.pop(tid, None)
             return None
         centroid = self.blobs.states[tid].centroid[:2]
@@ -600,8 +599,7 @@ class Tracker:
         if person.occlusion is not None:
             person.occlusion.remember(pose)
             pose = person.occlusion.with_memory(pose)
-            names = person.model.part_names
-            hidden = {part: not person.part_visible[names.index(part)] for part in names}
+            hidden = dict(zip(person.model.part_names, ~person.part_visible))
             legs = [side for side in ("left", "right") if hidden[f"{side}_thigh"]]
             shins = [side for side in ("left", "right") if hidden[f"{side}_shin"] and not hidden[f"{side}_thigh"]]
             if legs or shins:

@@ -85,6 +85,12 @@ def _model_breadth(model: BodyModel, height: float) -> float:
     return float(np.max(centre[cut, 1] + half[cut]) - np.min(centre[cut, 1] - half[cut]))
 
 
+def top_height(heights: np.ndarray) -> float:
+    """The top of a person's points: the TOP_RANK-th highest of ``heights`` (N,) metres,
+    N >= TOP_RANK (a few stray points do not raise it)."""
+    return float(np.partition(heights, heights.shape[0] - TOP_RANK)[heights.shape[0] - TOP_RANK])
+
+
 def dims_from_observation(points, *, floor_z: float = 0.0) -> BodySize:
     """Body size of a standing person from their observed 3D points.
 
@@ -103,7 +109,7 @@ def dims_from_observation(points, *, floor_z: float = 0.0) -> BodySize:
     if not math.isfinite(floor_z):
         raise ValueError(f"floor_z must be a finite height in metres, got {floor_z!r}")
     z = points[:, 2] - floor_z
-    top = float(np.partition(z, z.shape[0] - TOP_RANK)[z.shape[0] - TOP_RANK]) + TOP_BIAS
+    top = top_height(z) + TOP_BIAS
     stature = float(np.clip(top, 1.0, 2.2))
     dims = DEFAULT_DIMS.scaled(stature)
     in_slice = (z >= CHEST_SLICE[0] * stature) & (z <= CHEST_SLICE[1] * stature)
