@@ -35,7 +35,8 @@ FRONT = camera_preset("kinect_v1", world_from_camera=look_at((0.0, 0.0, 1.6), (0
 def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarray, hold=None):
     """One frame of the grid in plain NumPy: (probabilities (N, 3) float64, states (N,), visibility (N,)).
     hold : optional (N,) bool, cells stepped with psi = 0 (the M row renormalised), their O
-        share moved to M first where their MAP state is M."""
+        share moved to M first where their MAP state is M. Cells no camera sees whose MAP
+        state is O step with alpha = 0."""
     centres = grid.spec.centers().reshape(-1, 3)
     likelihood = np.ones((len(centres), 3))
     covered = np.zeros(len(centres), bool)
@@ -57,15 +58,20 @@ def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarra
         covered |= valid
         with np.errstate(invalid="ignore"):
             seen |= valid & (epsilon >= -band)
-    q = probabilities.astype(np.float64) @ grid.transition
+    unseen = grid.transition.copy()
+    unseen[O] = [1.0, 0.0, 0.0]  # a static cell no camera sees stays
+    prior = probabilities.astype(np.float64)
+    kept = ~seen & (prior[:, O] >= prior[:, M]) & (prior[:, O] >= prior[:, E])
+    q = np.where(kept[:, None], prior @ unseen, prior @ grid.transition)
     if hold is not None:
-        held = grid.transition.copy()
-        held[M] = [0.0, held[M, M], held[M, E]] / (held[M, M] + held[M, E])
-        prior = probabilities[hold].astype(np.float64)
-        moving = (prior[:, M] > prior[:, O]) & (prior[:, M] >= prior[:, E])
-        prior[moving, M] += prior[moving, O]
-        prior[moving, O] = 0.0
-        q[hold] = prior @ held
+        for transition, where in ((grid.transition, hold & ~kept), (unseen, hold & kept)):
+            held = transition.copy()
+            held[M] = [0.0, held[M, M], held[M, E]] / (held[M, M] + held[M, E])
+            prior = probabilities[where].astype(np.float64)
+            moving = (prior[:, M] > prior[:, O]) & (prior[:, M] >= prior[:, E])
+            prior[moving, M] += prior[moving, O]
+            prior[moving, O] = 0.0
+            q[where] = prior @ held
     q *= likelihood
     q /= q.sum(axis=1, keepdims=True)
     q[q < FLUSH] = 0.0
@@ -443,6 +449,36 @@ def test_cells_behind_the_desk_are_hidden():
     assert np.all(grid.visibility_at(open_room) == VISIBLE)
     beside_camera = np.array([[2.0, 0.3, 0.5], [-2.0, 0.3, 1.5], [0.0, 20.0, 1.0]])  # outside the view / the grid
     assert np.all(grid.visibility_at(beside_camera) == UNOBSERVED)
+
+
+def test_a_wall_hidden_for_long_is_still_background_when_seen_again():
+    """A board stands in front of the wall for 150 frames (twice the time in which the
+    alpha leak would have emptied the hidden wall cells) and is taken away: the wall behind
+    it is static at once, not a moving object (a ghost person where someone stood)."""
+    grid = OccupancyGrid(spec_from_cameras([FRONT], cell=0.1), [FRONT])
+    wall = np.full((FRONT.height, FRONT.width), 3.0, np.float32)
+    board = wall.copy()
+    board[150:330, 250:390] = 2.0
+    for depth in [wall] * 5 + [board] * 150:
+        grid.update({"front": depth})
+    behind = np.zeros_like(wall, bool)
+    behind[170:310, 270:370] = True
+
+    def cells_of(depth):
+        index = cells_from_depth(np.where(behind, depth, 0.0), FRONT, grid.spec)
+        mask = np.zeros(grid.spec.num_cells, bool)
+        mask[index[index >= 0]] = True
+        return mask.reshape(grid.spec.shape)
+
+    wall_cells = cells_of(wall)
+    assert wall_cells.sum() > 20
+    assert np.all(grid.visibility[wall_cells] == HIDDEN) and np.all(grid.states[wall_cells] == O)
+    for _ in range(3):
+        grid.update({"front": wall})
+        assert np.all(grid.visibility[wall_cells] == VISIBLE)
+        assert not grid.moving_mask()[wall_cells].any() and np.all(grid.states[wall_cells] == O)
+    board_cells = cells_of(board)
+    assert board_cells.sum() > 20 and np.all(grid.states[board_cells] == E)  # the board is gone
 
 
 def test_a_second_camera_sees_what_the_first_cannot():

@@ -21,7 +21,10 @@ Conventions shared with the wrapper:
   state before the step is M, its O share first moves to M (the tracker's hold on the
   cells of the people it follows, see ``OccupancyGrid.update``). A per-cell mask
   costs one byte load per cell in the parallel loop; a list of indices would need a
-  scatter into such a mask first.
+  scatter into such a mask first;
+- a cell whose MAP state is O and that no camera sees (hidden or unobserved from all)
+  steps with ``alpha = 0`` (the O row ``(1, 0, 0)``): a static object is not removed
+  while nobody can see it.
 """
 
 from __future__ import annotations
@@ -121,15 +124,18 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                 q_o = probabilities[n, 0]
                 q_m = probabilities[n, 1]
                 q_e = probabilities[n, 2]
+                o_o, o_e = t_oo, t_oe
+                if not seen and q_o >= q_m and q_o >= q_e:  # static and unseen: it stays
+                    o_o, o_e = 1.0, 0.0
                 m_o, m_m, m_e = t_mo, t_mm, t_me  # the M row: the only one a hold changes
                 if use_hold and hold[n]:
                     m_o, m_m, m_e = h_mo, h_mm, h_me
                     if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
                         q_m += q_o
                         q_o = 0.0
-                r_o = (q_o * t_oo + q_m * m_o + q_e * t_eo) * b_occupied
+                r_o = (q_o * o_o + q_m * m_o + q_e * t_eo) * b_occupied
                 r_m = (q_o * t_om + q_m * m_m + q_e * t_em) * b_occupied
-                r_e = (q_o * t_oe + q_m * m_e + q_e * t_ee) * b_empty
+                r_e = (q_o * o_e + q_m * m_e + q_e * t_ee) * b_empty
                 scale = 1.0 / (r_o + r_m + r_e)
                 r_o *= scale
                 r_m *= scale
