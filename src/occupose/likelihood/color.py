@@ -86,7 +86,9 @@ class ColorLikelihood:
         """(P, K, bins^3) float64 normalised colour histograms of each particle's parts
         (all-zero for a part without a counted sample); arguments as :meth:`evaluate`.
         The estimate's histograms are the next frame's reference."""
-        a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
+        return self._histograms(*check_capsules(a, b, radii, capsule_part, num_parts))
+
+    def _histograms(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         counts = np.zeros((a.shape[0], num_parts, self.num_bins))
         for rotation, shift, cam, hidden, cells in self._views:
             _kernels.color_counts(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
@@ -109,13 +111,16 @@ class ColorLikelihood:
         """(P, K) float64 log-likelihoods of particles with capsules a, b (P, C, 3) metres,
         radii (C, 2) metres, capsule_part (C,) int in [0, num_parts). Zero before a
         reference is set; the reference must have K rows."""
+        return self.evaluate_checked(*check_capsules(a, b, radii, capsule_part, num_parts))
+
+    def evaluate_checked(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
+        """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         if self._sqrt_reference is None:
-            a, _, _, _, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
             return np.zeros((a.shape[0], num_parts))
         if self._sqrt_reference.shape[0] != num_parts:
             raise ValueError(f"the colour reference has {self._sqrt_reference.shape[0]} parts, "
                              f"evaluate was given num_parts={num_parts}")
-        hist = self.histograms(a, b, radii, capsule_part, num_parts)
+        hist = self._histograms(a, b, radii, capsule_part, num_parts)
         coefficient = np.einsum("pkj,kj->pk", np.sqrt(hist), self._sqrt_reference)
         distance = np.sqrt(np.clip(1.0 - coefficient, 0.0, None))
         distance[hist.sum(axis=2) == 0] = 1.0

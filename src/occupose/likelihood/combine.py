@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from occupose.likelihood._capsules import check_capsules
 from occupose.likelihood.color import ColorLikelihood
 from occupose.likelihood.free import FreeSpaceLikelihood
 from occupose.likelihood.observation import Observation
@@ -42,10 +43,12 @@ class Sum:
             self.terms[name] = TERMS[name](observation, **term_options)
 
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
-        """(P, K) float64: the sum of the terms' log-likelihoods (see the terms' evaluate)."""
+        """(P, K) float64: the sum of the terms' log-likelihoods (see the terms' evaluate).
+        The capsules are checked once, here, not by every term."""
+        checked = check_capsules(a, b, radii, capsule_part, num_parts)
         total = None
         for term in self.terms.values():
-            values = term.evaluate(a, b, radii, capsule_part, num_parts)
+            values = term.evaluate_checked(*checked)
             total = values if total is None else total + values
         return total
 

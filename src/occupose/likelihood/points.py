@@ -71,7 +71,10 @@ class PointsLikelihood:
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """(P, K) float64 log-likelihoods of particles with capsules a, b (P, C, 3) metres,
         radii (C, 2) metres, capsule_part (C,) int in [0, num_parts)."""
-        a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
+        return self.evaluate_checked(*check_capsules(a, b, radii, capsule_part, num_parts))
+
+    def evaluate_checked(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
+        """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         out = np.zeros((a.shape[0], num_parts))
         _kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, self._blocks.weight, out)
         out *= -1.0 / (self.num_points * self.scale)

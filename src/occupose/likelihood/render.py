@@ -79,7 +79,10 @@ class RenderLikelihood:
     def evaluate(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """(P, K) float64 log-likelihoods of particles with capsules a, b (P, C, 3) metres,
         radii (C, 2) metres, capsule_part (C,) int in [0, num_parts)."""
-        a, b, radii, capsule_part, num_parts = check_capsules(a, b, radii, capsule_part, num_parts)
+        return self.evaluate_checked(*check_capsules(a, b, radii, capsule_part, num_parts))
+
+    def evaluate_checked(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
+        """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         out = np.zeros((a.shape[0], num_parts))
         for rotation, shift, cam, u0, v0, observed, index, x, y, z in self._views:
             _kernels.render_sigmas(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
