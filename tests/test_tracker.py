@@ -63,6 +63,15 @@ def test_tracks_the_walk_from_its_blob_without_a_start_pose(walk):
     assert result.fps > 0 and set(result.seconds) >= {"grid", "blobs", "observations", "pose", "total"}
 
 
+def test_track_frames_takes_the_first_num_frames_of_longer_input(walk):
+    scenario, rendered = walk
+    result = track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0), rendered, 20)
+    assert result.num_frames == 20 and list(result.tracks) == [1]
+    joints, visible = result.tracks[1]
+    assert joints.shape == (20, len(JOINTS), 3) and visible.shape == (20, len(JOINTS))
+    assert np.isfinite(joints[-1]).all()  # tracked up to the last of the 20
+
+
 def test_overlapping_the_grid_with_the_pose_stage_tracks_alike(walk):
     """The grid update of frame t + 1 runs during stage 3 of frame t (its hold mask from the
     bodies of frame t - 1): the same person, tracked as well."""

@@ -35,6 +35,7 @@ every setting can be overridden.
 
 from __future__ import annotations
 
+import itertools
 import time
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -630,15 +631,16 @@ class TrackingResult:
 
 
 def track_frames(tracker: Tracker, frames, num_frames: int, progress=None, overlap: bool = False) -> TrackingResult:
-    """Run ``tracker`` over ``frames`` (an iterable of objects with ``.index`` and ``.depth``,
-    e.g. ``Recording.frames()``), ``num_frames`` of them. ``progress`` : callable(n) called
-    after each frame, or None. ``overlap`` : update the grid with the next frame while the
-    pose stage works on the current one (:meth:`Tracker.update`'s ``upcoming``)."""
+    """Run ``tracker`` over ``frames`` (an iterable of objects with ``.index`` and
+    ``.depth``, e.g. ``Recording.frames()``, indices from 0), the first ``num_frames`` of
+    them. ``progress`` : callable(n) called after each frame, or None. ``overlap`` : update
+    the grid with the next frame while the pose stage works on the current one
+    (:meth:`Tracker.update`'s ``upcoming``)."""
     joints = {}
     visible = {}
     startup = 0.0
     total = 0.0
-    frames = iter(frames)
+    frames = itertools.islice(frames, num_frames)
     upcoming = next(frames, None)
     n = -1
     while upcoming is not None:
