@@ -76,6 +76,16 @@ class PoseProblem:
         self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self.heading_dof in g.dofs), None)
         self._likelihood = None
 
+    def resize(self, model: BodyModel) -> None:
+        """Go on with ``model``: the same model with other body dimensions (its DOFs,
+        parts and limits must be this one's)."""
+        if (model.name, model.dof_names, model.part_names) != (self.model.name, self.model.dof_names,
+                                                               self.model.part_names) \
+                or not np.array_equal(model.limits, self.model.limits):
+            raise ValueError(f"resize needs the same model ({self.model.name!r}) with other dimensions, "
+                             f"got {model.name!r}")
+        self.model = model
+
     def set_observation(self, observation: Observation) -> None:
         """Use this frame's observation for the following likelihood calls."""
         self._likelihood = make_likelihood(self.likelihood_name, observation, **self.likelihood_options)
@@ -88,15 +98,22 @@ class PoseProblem:
         out = self._likelihood.evaluate(a, b, self.model.capsule_radii, self.model.capsule_part,
                                         len(self.model.part_names))
         if self.floor is not None:
-            lowest = np.minimum(a[..., 2] - self.model.capsule_radii[:, 0], b[..., 2] - self.model.capsule_radii[:, 1])
-            sunk = np.maximum(self.floor - FLOOR_SLACK - lowest, 0.0)
-            if sunk.any():
-                np.add.at(out.T, self.model.capsule_part, -FLOOR_COST * sunk.T)
+            add_floor_term(self.model, a, b, self.floor, out)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
         out[:, self.hidden_parts] = 0.0
         return out
+
+
+def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray) -> None:
+    """Add the floor term to per-part log-likelihoods ``out`` (P, K), in place: each capsule
+    of ``model`` (ends a, b (P, C, 3) world metres) whose surface reaches more than
+    FLOOR_SLACK below ``floor`` (metres) costs its part FLOOR_COST nats per metre beyond."""
+    lowest = np.minimum(a[..., 2] - model.capsule_radii[:, 0], b[..., 2] - model.capsule_radii[:, 1])
+    sunk = np.maximum(floor - FLOOR_SLACK - lowest, 0.0)
+    if sunk.any():
+        np.add.at(out.T, model.capsule_part, -FLOOR_COST * sunk.T)
 
 
 def _moved_parts(model: BodyModel, dofs: np.ndarray) -> np.ndarray:
