@@ -21,6 +21,8 @@ from occupose.synth.scenarios import build_scenario
 from occupose.tracker import (
     INIT_FRAMES,
     METHODS,
+    PROPORTION_EVERY,
+    PROPORTION_FRAMES,
     WALK_FRAMES,
     WALK_FROM,
     WALK_PRIOR,
@@ -61,6 +63,22 @@ def test_tracks_the_walk_from_its_blob_without_a_start_pose(walk):
     assert errors.mean() < 0.10  # measured 7.7 cm
     assert np.all(visible[tracked])  # nothing hides the walker
     assert result.fps > 0 and set(result.seconds) >= {"grid", "blobs", "observations", "pose", "total"}
+    assert tracker.people[1].fits == 0  # no proportion fits unless asked for
+
+
+def test_with_proportions_the_walker_is_fitted_once_in_its_first_estimates(walk):
+    """With ``proportions=True`` a person is refitted after PROPORTION_EVERY x PROPORTION_FRAMES
+    estimates in view (30: once in the walk's 60 frames), and tracked as well after it."""
+    scenario, rendered = walk
+    tracker = Tracker(scenario.cameras, scenario.fps, "ours", seed=0, proportions=True)
+    result = track_frames(tracker, rendered, len(rendered))
+    person = tracker.people[1]
+    assert person.fits == 1 and person.in_view >= PROPORTION_EVERY * PROPORTION_FRAMES
+    assert person.problem.model is person.model  # the filter goes on with the refitted model
+    joints = result.tracks[1][0]
+    tracked = np.isfinite(joints[:, 0, 0])
+    gt = np.stack([f.joints[0] for f in rendered])
+    assert frame_errors(joint_errors(gt[tracked], joints[tracked])).mean() < 0.10
 
 
 def test_track_frames_takes_the_first_num_frames_of_longer_input(walk):
