@@ -181,6 +181,20 @@ def test_problem_rejects_unknown_likelihood(walk):
         problem.set_observation(walk[1][0])
 
 
+def test_resize_takes_the_same_model_with_other_dimensions_only(walk):
+    joints, observations = walk
+    model = body_model("full")
+    problem = PoseProblem(model)
+    problem.set_observation(observations[0])
+    pose = pose_from_joints(model, joints[0])[None]
+    before = problem.log_likelihood(pose)
+    taller = body_model("full", model.dims.scaled(1.9))
+    problem.resize(taller)
+    assert problem.model is taller and not np.allclose(problem.log_likelihood(pose), before)
+    with pytest.raises(ValueError, match="resize needs the same model \\('full'\\)"):
+        problem.resize(body_model("upper"))
+
+
 # ---------------------------------------------------------------------- PoseEstimator
 
 
