@@ -19,6 +19,7 @@ from occupose.recording import Recording, RecordingWriter
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.tracker import (
+    CARRY_FRAMES,
     INIT_FRAMES,
     METHODS,
     PROPORTION_EVERY,
@@ -403,3 +404,31 @@ def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     assert direction == pytest.approx(0.0) and weight == pytest.approx(WALK_PRIOR)
     person.carry()  # hidden again at once: carried on along +x
     np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])
+
+
+def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view():
+    """The estimates of a person walking into occlusion stall at the cabinet's edge: the
+    carry takes its step from the last estimates with every part in view (while they are
+    recent), and a person suspended on its blob while walking comes back where it was
+    carried to, not at its blob's centroid (which stays at the edge)."""
+    model = body_model("full")
+    person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.centroid = np.array([0.0, 0.0, 1.0])
+    for i in range(10):  # in full view, 1.2 m/s along +x
+        person.settle(pose + np.eye(model.num_dofs)[0] * 0.04 * i)
+    person.part_visible[model.part_names.index("right_shin")] = False
+    for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s
+        person.settle(pose + np.eye(model.num_dofs)[0] * (0.36 + 0.01 * (i + 1)))
+    np.testing.assert_allclose(person.step(), [0.04, 0.0])
+    person.carry()
+    np.testing.assert_allclose(person.pose[:2], [0.45, 0.0])
+    person.walked_on = True  # suspended on its blob while walking
+    person.come_back(np.array([0.9, 0.3, 1.0]))
+    np.testing.assert_allclose(person.pose[:2], [0.45, 0.0])
+    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [0.45, 0.0])
+    assert not person.walked_on and not person.lost
+    for _ in range(CARRY_FRAMES):  # standing partly hidden for long: its own recent path again
+        person.settle(person.pose)
+    np.testing.assert_allclose(person.step(), [0.0, 0.0], atol=1e-12)

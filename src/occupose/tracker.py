@@ -22,10 +22,12 @@ A frame:
    occlusion check (its previous estimate moved to the blob's new centre of mass), then
    the filter on the visible subtree; hidden legs (and hidden shins under seen thighs) are placed
    with their feet on the floor;
-5. a person whose torso is hidden is kept (suspended) and moved with its blob; one whose
-   blob is gone is kept and carried at its last velocity; either is placed back on its
-   blob when seen again, keeping the way it walked (a new blob track near it is its); it
-   ends when its blob has been gone for longer than ``max_gap_s``.
+5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if
+   it walks (the speed of its last estimates in full view, while recent) and is not at the
+   image's edge, else moved with its blob; one whose blob is gone is kept and carried at that speed; either is placed
+   back on its blob when seen again (where it was carried to, if it walked on with its
+   blob in view), keeping the way it walked (a new blob track near it is its); it ends
+   when its blob has been gone for longer than ``max_gap_s``.
 
 With ``upcoming`` frames, step 1 of the next frame runs on a second thread during step 4.
 
@@ -148,7 +150,8 @@ INIT_SPREAD = (0.05, 0.05, 0.05, 0.15, 0.1)
 #: Seconds a track survives without its blob.
 MAX_GAP_S = 3.0
 #: A person gone or suspended walks on at its pelvis's mean velocity over this many last
-#: estimates, at most CARRY_SPEED metres per frame (2 m/s at 30 fps).
+#: estimates (in full view, while recent: _Person.step), at most CARRY_SPEED metres per
+#: frame (2 m/s at 30 fps).
 CARRY_FRAMES = 15
 CARRY_SPEED = 0.067
 #: Largest horizontal offset between the pelvis and its blob's centroid kept for placing
@@ -230,6 +233,9 @@ class _Person:
         self.lost = False  # gone or suspended since the last estimate
         self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
         self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
+        self.clear: list[np.ndarray] = []  # the same of those with every part in view,
+        self.since_clear = 0  # and the estimates since the last of them
+        self.walked_on = False  # carried while suspended on its blob (come_back)
         self.part_visible = np.ones(model.num_parts, bool)
         self.fps = fps
         self.since_turn = 0  # estimates since the last turn round (face_the_way_walked)
@@ -244,6 +250,9 @@ class _Person:
         anchor = pose[:2] - self.centroid[:2]  # a partly hidden blob's centroid is off: clipped
         self.anchor = anchor * min(1.0, MAX_ANCHOR / max(float(np.hypot(*anchor)), 1e-12))
         self.path = (self.path + [pose[:2].copy()])[-CARRY_FRAMES:]
+        self.since_clear += 1
+        if self.part_visible.all():
+            self.clear, self.since_clear = (self.clear + [pose[:2].copy()])[-CARRY_FRAMES:], 0
 
     def face_the_way_walked(self) -> None:
         """In a person's first START_CHECK_S seconds, turn the whole estimate round (heading +
@@ -304,28 +313,39 @@ class _Person:
             return None
         return float(np.arctan2(velocity[1], velocity[0])), WALK_PRIOR * min(1.0, (speed - WALK_FROM) / WALK_RAMP)
 
+    def step(self) -> np.ndarray:
+        """(2,) metres per frame: the pelvis's mean step over its last estimates with every
+        part in view when the last of them is at most CARRY_FRAMES estimates old, else over
+        its last estimates; at most CARRY_SPEED. A person walking behind a cabinet is
+        estimated on what is left in view, which stalls at the cabinet's edge: those last
+        estimates fall behind (0.6 against 1 m/s in enter_exit_occlusion)."""
+        path = self.clear if len(self.clear) > 1 and self.since_clear <= CARRY_FRAMES else self.path
+        if len(path) < 2:
+            return np.zeros(2)
+        step = (path[-1] - path[0]) / (len(path) - 1)
+        return step * min(1.0, CARRY_SPEED / max(float(np.hypot(*step)), 1e-12))
+
     def carry(self) -> None:
-        """A frame without an estimate (gone or suspended): the pose walks on at the pelvis's
-        mean velocity over the last estimates (at most CARRY_SPEED metres per frame)."""
-        if len(self.path) > 1:
-            step = (self.path[-1] - self.path[0]) / (len(self.path) - 1)
-            step *= min(1.0, CARRY_SPEED / max(float(np.hypot(*step)), 1e-12))
-            self.pose = self.pose.copy()
-            self.pose[:2] += step
+        """A frame without an estimate (gone or suspended): the pose walks on at :meth:`step`."""
+        self.pose = self.pose.copy()
+        self.pose[:2] += self.step()
         self.lost = True
 
     def come_back(self, centroid: np.ndarray) -> None:
         """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
-        plus the anchor. The particles are where the last estimate left them, not where
+        plus the anchor, or where it was carried to if it walked on while suspended on
+        this blob (the centroid of a body coming out from behind a cabinet stays at the
+        cabinet's edge). The particles are where the last estimate left them, not where
         the pose was carried since, so they are shifted from the estimate. The path is moved
         along (the jump onto the blob is no step of the person's): the way it walked before
         goes on, so a person hidden again soon after is carried on that way."""
+        place = self.pose[:2] if self.walked_on else centroid[:2] + self.anchor
         offset = np.zeros(self.model.num_dofs)
-        offset[:2] = centroid[:2] + self.anchor - self.estimator.filter.estimate[:2]
+        offset[:2] = place - self.estimator.filter.estimate[:2]
         self.estimator.shift(offset)
         self.pose = self.pose.copy()
-        self.pose[:2] = centroid[:2] + self.anchor
-        self.centroid, self.lost = centroid, False
+        self.pose[:2] = place
+        self.centroid, self.lost, self.walked_on = centroid, False, False
         if self.path:
             self.path = [p + (self.pose[:2] - self.path[-1]) for p in self.path]
 
@@ -627,8 +647,13 @@ class Tracker:
                                              depths, assigned, self.cameras, tid)
 
             person.part_visible = person.occlusion.update(moved, hidden)
-            if person.occlusion.suspended:  # kept where its blob is, not estimated
-                person.pose, person.lost = moved, True
+            if person.occlusion.suspended:  # kept, not estimated: walks on, or stays with its blob
+                # (at the image's edge it stays with its blob: the camera cannot show it walk on)
+                if np.hypot(*person.step()) * self.fps > WALK_FROM and not self._at_border(observation):
+                    person.carry()
+                    person.walked_on = True
+                else:
+                    person.pose, person.lost = moved, True
                 return person.estimate(False)
             active, scale = person.occlusion.active_dofs(), person.occlusion.diffusion_scale()
             person.problem.hidden_parts = ~person.part_visible
