@@ -22,12 +22,12 @@ A frame:
    occlusion check (its previous estimate moved to the blob's new centre of mass), then
    the filter on the visible subtree; hidden legs (and hidden shins under seen thighs) are placed
    with their feet on the floor;
-5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if
-   it walks (the speed of its last estimates in full view, while recent) and is not at the
-   image's edge, else moved with its blob; one whose blob is gone is kept and carried at that speed; either is placed
-   back on its blob when seen again (where it was carried to, if it walked on with its
-   blob in view), keeping the way it walked (a new blob track near it is its); it ends
-   when its blob has been gone for longer than ``max_gap_s``.
+5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
+   walks (the speed of its last estimates in full view, while recent) and is not at the
+   image's edge, else moved with its blob; one whose blob is gone is kept and carried at
+   that speed; either is placed back on its blob when seen again (where it was carried to,
+   if it walked on with its blob in view), keeping the way it walked (a new blob track near
+   it is its); it ends when its blob has been gone for longer than ``max_gap_s``.
 
 With ``upcoming`` frames, step 1 of the next frame runs on a second thread during step 4.
 
@@ -280,10 +280,10 @@ class _Person:
             self.since_turn = 0
 
     def learn_proportions(self, observation: Observation) -> None:
-        """Keep every PROPORTION_EVERY-th estimate with every part in view and its
-        ``observation``; with PROPORTION_FRAMES kept, fit the segment lengths to them and
-        go on with a model of those lengths (its pelvis height moved with the fit), at
-        most PROPORTION_FITS times."""
+        """With Method.proportions: keep every PROPORTION_EVERY-th estimate with every part
+        in view and its ``observation``; with PROPORTION_FRAMES kept, fit the body's widths
+        to them and go on with a model of those widths (the particles moved so that the
+        estimate keeps its joints), at most PROPORTION_FITS times."""
         if not self.method.proportions or self.fits >= PROPORTION_FITS or not self.part_visible.all():
             return
         self.in_view += 1
