@@ -517,6 +517,7 @@ class Tracker:
         for pid, person in self.people.items():
             if pid not in out:  # gone (behind something): kept, not estimated
                 person.carry()
+                person.walked_on = False  # back on whatever blob it is seen on
                 out[pid] = person.estimate(False)
         self._tick("pose", clock)
         return dict(sorted(out.items()))
