@@ -107,12 +107,13 @@ def fit_proportions(model: BodyModel, poses, observations, *, likelihood: str = 
         return out
 
     dims = model.dims
-    start = scores([dims])[0]
+    start = best = scores([dims])[0]
     for _ in range(SWEEPS):
         for group in MODEL_GROUPS[model.name]:
             candidates = [_scaled(dims, average, GROUPS[group], factor) for factor in STEPS]
-            dims = candidates[int(np.argmax(scores(candidates)))]
-    return FittedProportions(dims, refitted(dims)[1][-1], float(scores([dims])[0] - start))
+            values = scores(candidates)
+            dims, best = candidates[int(np.argmax(values))], float(np.max(values))
+    return FittedProportions(dims, refitted(dims)[1][-1], best - start)
 
 
 def _scaled(dims: BodyDims, average: BodyDims, names: tuple[str, ...], factor: float) -> BodyDims:
