@@ -8,7 +8,7 @@ import pytest
 
 from scipy import stats
 
-from occupose.body import (BODY_MODELS, arm_angles, body_model, capsules_from_poses, diffuse, diffusion_scales,
+from occupose.body import (BODY_MODELS, limb_angles, body_model, capsules_from_poses, diffuse, diffusion_scales,
                            dims_from_observation, joints_from_poses, pose_from_joints, root_drift,
                            standing_pose)
 from occupose.camera import points_from_depth
@@ -286,7 +286,7 @@ def test_arm_angles_give_back_an_arm_of_a_leaning_turned_body(name):
         if dof in m.dof_names:
             pose[m.dof(dof)] = value
     joints = joints_from_poses(m, pose[None])[0]
-    got = arm_angles(m, pose, "right", *(joints[J[f"right_{j}"]] for j in ("shoulder", "elbow", "wrist")))
+    got = limb_angles(m, pose, "right", "arm", *(joints[J[f"right_{j}"]] for j in ("shoulder", "elbow", "wrist")))
     want = [pose[m.dof(f"right_{n}")] for n in ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")]
     np.testing.assert_allclose(got, want, atol=1e-9)
 

@@ -1,4 +1,4 @@
-"""Data-driven arm proposals: where they point, when there are none, and what they fix."""
+"""Data-driven limb proposals: where they point, when there are none, and what they fix."""
 
 from __future__ import annotations
 
@@ -9,9 +9,10 @@ from occupose.body import body_model, capsules_from_poses, joints_from_poses, st
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation
 from occupose.pose import PoseEstimator, PoseProblem
-from occupose.proposals import arm_dofs, arm_proposals, reach_towards
+from occupose.proposals import FOOT_LOST, feet, limb_dofs, limb_proposals, reach_towards, unexplained_points
 
 WRIST = JOINT_INDEX["right_wrist"]
+ANKLE = JOINT_INDEX["left_ankle"]
 
 
 def _surface_points(model, pose, rng, count=1000):
@@ -41,16 +42,16 @@ def raised():
 
 def test_arm_dofs_are_shoulder_and_elbow_of_that_side():
     model = body_model("upper")
-    assert [model.dof_names[d] for d in arm_dofs(model, "left")] == [
+    assert [model.dof_names[d] for d in limb_dofs(model, "left")] == [
         "left_shoulder_flex", "left_shoulder_abd", "left_shoulder_rot", "left_elbow"]
 
 
 def test_a_lost_arm_is_proposed_where_its_points_are(raised):
     model, hanging, pose, points = raised
-    proposals = arm_proposals(model, hanging, Observation(points, ()))
+    proposals = limb_proposals(model, hanging, Observation(points, ()))
     assert len(proposals) == 1  # the left arm is where its points are
     dofs, values = proposals[0]
-    assert np.array_equal(dofs, arm_dofs(model, "right"))
+    assert np.array_equal(dofs, limb_dofs(model, "right"))
     proposed = hanging.copy()
     proposed[dofs] = values
     wrist = joints_from_poses(model, proposed[None])[0, WRIST]
@@ -78,8 +79,8 @@ def test_reach_towards_bends_the_arm_where_its_points_are_and_straightens_it_out
 
 def test_no_proposal_when_the_estimate_explains_the_points(raised):
     model, _, pose, points = raised
-    assert arm_proposals(model, pose, Observation(points, ())) == []
-    assert arm_proposals(model, pose, Observation(points[:5], ())) == []
+    assert limb_proposals(model, pose, Observation(points, ())) == []
+    assert limb_proposals(model, pose, Observation(points[:5], ())) == []
 
 
 def _track_static(model, start, points, proposals, active=None, frames=6):
@@ -109,11 +110,59 @@ def test_proposals_let_the_filter_find_a_lost_arm_that_diffusion_does_not(raised
 def test_a_frozen_arm_gets_no_proposal(raised):
     model, hanging, _, points = raised
     active = np.ones(model.num_dofs, bool)
-    active[arm_dofs(model, "right")] = False
+    active[limb_dofs(model, "right")] = False
     found = _track_static(model, hanging, points, 0.1, active=active, frames=2)
-    np.testing.assert_allclose(found[arm_dofs(model, "right")], hanging[arm_dofs(model, "right")], atol=1e-12)
+    np.testing.assert_allclose(found[limb_dofs(model, "right")], hanging[limb_dofs(model, "right")], atol=1e-12)
 
 
 def test_estimator_rejects_a_bad_proposal_share():
     with pytest.raises(ValueError, match="proposals"):
         PoseEstimator(PoseProblem(body_model("full")), "sir", 10, np.random.default_rng(0), proposals=1.0)
+
+
+@pytest.fixture(scope="module")
+def stepped():
+    """(model, the pose standing, the pose with the left leg stepped out to the side
+    (ankle 0.3 m away), points on the stepped pose)."""
+    model = body_model("full")
+    standing = standing_pose(model, (0.0, 2.5), 0.0)
+    pose = standing.copy()
+    pose[model.dof_names.index("left_hip_abd")] = 0.4
+    pose[2] -= 0.03  # the pelvis lower, as with a leg stepped out: the foot on the floor
+    return model, standing, pose, _surface_points(model, pose, np.random.default_rng(1), 3000)
+
+
+def test_feet_are_found_where_the_unexplained_points_near_the_floor_are(stepped):
+    model, standing, pose, points = stepped
+    loose = unexplained_points(model, standing, Observation(points, ()))
+    found = feet(model, standing, loose, floor=0.0)
+    assert list(found) == ["left"]  # the right leg explains its points
+    true_ankle = joints_from_poses(model, pose[None])[0, ANKLE]
+    assert found["left"][2] == pytest.approx(model.dims.ankle_height)
+    assert np.linalg.norm(found["left"][:2] - true_ankle[:2]) < 0.05
+    assert feet(model, standing, loose, floor=-0.5) == {}  # the floor lower: no point is near it
+
+
+def test_a_lost_leg_is_proposed_where_its_foot_is_only_for_a_standing_person(stepped):
+    model, standing, pose, points = stepped
+    observation = Observation(points, ())
+    legs = [(dofs, values) for dofs, values in limb_proposals(model, standing, observation)
+            if model.dof_names[dofs[0]].endswith("hip_flex")]
+    assert len(legs) == 1 and np.array_equal(legs[0][0], limb_dofs(model, "left", "leg"))
+    proposed = standing.copy()
+    proposed[legs[0][0]] = legs[0][1]
+    true_ankle = joints_from_poses(model, pose[None])[0, ANKLE]
+    assert np.linalg.norm(joints_from_poses(model, standing[None])[0, ANKLE] - true_ankle) > 2 * FOOT_LOST
+    assert np.linalg.norm(joints_from_poses(model, proposed[None])[0, ANKLE] - true_ankle) < 0.05
+    for kwargs in ({"legs": False}, {"floor": None}):
+        assert not any(model.dof_names[d[0]].endswith("hip_flex")
+                       for d, _ in limb_proposals(model, standing, observation, **kwargs))
+
+
+def test_reach_towards_bends_a_knee_forwards_where_nothing_is_seen():
+    hip, ankle = np.array([0.0, 0.0, 0.9]), np.array([0.0, 0.0, 0.2])  # 0.7 m below: a bent leg of 0.45 + 0.43
+    for forward in ([1.0, 0.0, 0.0], [0.0, -1.0, 0.0]):
+        knee, end = reach_towards(hip, ankle, 0.45, 0.43, None, bend=np.array(forward))
+        assert np.array_equal(end, ankle)
+        assert (knee - hip) @ forward > 0.2  # of the 8 places on the circle, the most forwards
+        assert abs(np.linalg.norm(knee - hip) - 0.45) < 1e-9

@@ -235,6 +235,32 @@ def test_planted_legs_keep_the_feet_on_the_floor():
     assert abs(ankle[2] - model.dims.ankle_height) < 0.03
 
 
+def test_planted_legs_reach_the_feet_that_show():
+    """A hidden leg whose foot shows (below a chair's back) reaches it, knee forwards; a
+    hidden shin under a seen thigh bends to put its ankle nearest its foot."""
+    model = body_model("full")
+    pose = standing_pose(model, (0.0, 2.5), -np.pi / 2)  # facing -y
+    joints = joints_from_poses(model, pose[None])[0]
+    foot = joints[JOINT_INDEX["left_ankle"]] + [0.05, -0.2, 0.0]  # 20 cm forwards, 5 cm out
+    pose[2] -= 0.1  # the pelvis 10 cm lower: the leg must bend to reach it
+    planted = planted_legs(model, pose, ["left"], feet={"left": foot})
+    got = joints_from_poses(model, planted[None])[0]
+    assert np.linalg.norm(got[JOINT_INDEX["left_ankle"]] - foot) < 0.01
+    hip, knee, ankle = (got[JOINT_INDEX[f"left_{j}"]] for j in ("hip", "knee", "ankle"))
+    assert (knee - (hip + ankle) / 2)[1] < -0.05  # the knee bends forwards (-y)
+    assert np.array_equal(planted[model.dof_names.index("right_knee")], pose[model.dof_names.index("right_knee")])
+    # a seated thigh over a hidden shin: the knee bend whose ankle is nearest the foot
+    seated = pose.copy()
+    seated[2] = 0.5
+    seated[model.dof_names.index("right_hip_flex")] = 1.5
+    knee = joints_from_poses(model, seated[None])[0, JOINT_INDEX["right_knee"]]
+    tucked = knee + [0.0, 0.25, -(knee[2] - model.dims.ankle_height) * 0.8]  # the foot drawn back under the seat
+    shin = planted_legs(model, seated, [], ["right"], feet={"right": tucked})
+    ankle = joints_from_poses(model, shin[None])[0, JOINT_INDEX["right_ankle"]]
+    plain = joints_from_poses(model, planted_legs(model, seated, [], ["right"])[None])[0, JOINT_INDEX["right_ankle"]]
+    assert np.linalg.norm(ankle - tucked) < 0.06 < np.linalg.norm(plain - tucked)
+
+
 # ------------------------------------------------------------------------------ the command line
 
 
@@ -376,15 +402,16 @@ def test_a_blob_whose_own_points_stay_below_a_seated_head_does_not_start(trackin
 
 def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
     person = _Person(body_model("full"), METHODS["ours"], 30.0, np.random.default_rng(0))
-    assert person.walking() is None  # no path yet
+    assert person.walking() is None and not person.standing()  # no path yet: neither
     person.path = [np.array([0.0, 0.04 * i]) for i in range(WALK_FRAMES)]  # 1.2 m/s along +y
     direction, weight = person.walking()
     assert direction == pytest.approx(np.pi / 2) and weight == pytest.approx(WALK_PRIOR)
+    assert not person.standing()
     person.path = [np.array([-0.02 * i, 0.0]) for i in range(WALK_FRAMES)]  # 0.6 m/s along -x
     direction, weight = person.walking()
     assert abs(direction) == pytest.approx(np.pi) and weight == pytest.approx(WALK_PRIOR * (0.6 - WALK_FROM) / WALK_RAMP)
     person.path = [np.array([0.01 * i, 0.0]) for i in range(WALK_FRAMES)]  # 0.3 m/s: standing, swaying
-    assert person.walking() is None
+    assert person.walking() is None and person.standing()
 
 
 def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():

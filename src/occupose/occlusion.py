@@ -30,9 +30,10 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from occupose.body import BodyModel, joints_from_poses
+from occupose.body import BodyModel, joints_from_poses, limb_angles
 from occupose.camera import Camera, pixels_from_points
 from occupose.joints import JOINT_INDEX
+from occupose.proposals import forward, reach_towards
 
 #: Grid visibility code of a hidden cell (see occupose.grid.occupancy).
 HIDDEN_CELL = 2
@@ -252,30 +253,46 @@ def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsu
     return per_part > 0.5 * np.maximum(total, 1)
 
 
-def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins: Sequence[str] = ()) -> np.ndarray:
+def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins: Sequence[str] = (),
+                 feet: Mapping[str, np.ndarray] | None = None) -> np.ndarray:
     """``pose`` (D,) with the legs of ``sides`` ("left", "right") placed with their feet on
     the floor: hip flexion and knee bend (abduction and rotation 0) that put the ankle at
     the model's ankle height, the least bent such leg, the shin near vertical; for the
     ``shins`` (legs whose thigh is seen, its shin hidden) only the knee bend, the thigh
-    left as it is.
+    left as it is. Where ``feet`` (side -> (3,) ankle, world metres, as
+    :func:`occupose.proposals.feet` finds them) shows a leg's foot, the leg reaches it
+    instead: the knee bent forwards (the ankle as near it as the knee bend gets it, for a
+    shin).
 
     For legs hidden behind furniture: the paper keeps a hidden part's last seen
     configuration relative to its parent, so straight legs sink through the floor when
     the person sits down behind a table (and a shin last seen folded stays folded under a
     thigh that moves on); feet stay on the floor while standing, sitting down and getting
-    up, so this is where hidden legs are most likely.
+    up, so this is where hidden legs are most likely. A chair's back can hide a leg whose
+    foot shows below it.
     """
     pose = np.array(pose, float)
+    feet = feet or {}
     grid = np.meshgrid(PLANT_HIP, PLANT_KNEE, indexing="ij")
     for side, whole in [(side, True) for side in sides] + [(side, False) for side in shins]:
         dofs = [model.dof_names.index(f"{side}_hip_{n}") for n in ("flex", "abd", "rot")]
         bend = model.dof_names.index(f"{side}_knee")
+        if whole and side in feet:
+            hip, knee, ankle = joints_from_poses(model, pose[None])[0, [JOINT_INDEX[f"{side}_{j}"]
+                                                                         for j in ("hip", "knee", "ankle")]]
+            knee, ankle = reach_towards(hip, feet[side], np.linalg.norm(knee - hip), np.linalg.norm(ankle - knee),
+                                        None, bend=forward(model, pose))
+            pose[dofs + [bend]] = limb_angles(model, pose, side, "leg", hip, knee, ankle)
+            continue
         hip, knee = (grid[0].reshape(-1), grid[1].reshape(-1)) if whole else (pose[dofs[0]], PLANT_KNEE)
         candidates = np.repeat(pose[None], len(knee), axis=0)
         if whole:
             candidates[:, dofs] = np.stack([hip, np.zeros_like(hip), np.zeros_like(hip)], axis=1)
         candidates[:, bend] = knee
         ankle = joints_from_poses(model, candidates)[:, JOINT_INDEX[f"{side}_ankle"]]
-        cost = np.abs(ankle[:, 2] - model.dims.ankle_height) + 0.05 * np.abs(knee - hip) + 0.01 * knee
+        if side in feet:
+            cost = np.linalg.norm(ankle - feet[side], axis=1)
+        else:
+            cost = np.abs(ankle[:, 2] - model.dims.ankle_height) + 0.05 * np.abs(knee - hip) + 0.01 * knee
         pose = candidates[int(np.argmin(cost))]
     return pose

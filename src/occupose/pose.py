@@ -13,10 +13,10 @@ import numpy as np
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
 from occupose.filters import apply_limits, make_filter
 from occupose.likelihood import Observation, make_likelihood
-from occupose.proposals import ARM_DOFS, SIDES, arm_proposals
+from occupose.proposals import limb_proposals
 
 
-#: Default share of the particles given to the arm proposals (see PoseEstimator).
+#: Default share of the particles given to each limb proposal (see PoseEstimator).
 PROPOSAL_SHARE = 0.1
 #: The floor term (see PoseProblem): a part whose surface reaches more than FLOOR_SLACK
 #: metres below the floor costs FLOOR_COST nats per metre beyond that. The camera sees the
@@ -71,6 +71,9 @@ class PoseProblem:
         #: facing the opposite way costs, weight (1 - cos(heading - direction)) / 2 on the
         #: heading's part (people walk forwards); None for none. Set per frame by the tracker.
         self.walking: tuple[float, float] | None = None
+        #: Whether the person stands (feet on the floor: their points say where the legs
+        #: go, see :func:`occupose.proposals.feet`); set per frame by the tracker.
+        self.standing = False
         #: The index of the model's heading DOF, or None for a model without one.
         self.heading_dof = model.dof_names.index("heading") if "heading" in model.dof_names else None
         self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self.heading_dof in g.dofs), None)
@@ -177,8 +180,8 @@ class PoseEstimator:
     filter : a name of occupose.filters.FILTERS; particles : number of particles;
     rng : np.random.Generator; velocity_damping : share of the root's last translation
     added to every particle before a step (constant-velocity prediction; 0 = none);
-    proposals : share of the particles whose arm tries where the points unexplained by
-    the last estimate suggest (:func:`occupose.proposals.arm_proposals`; 0 = none);
+    proposals : share of the particles whose arm or leg tries where the points unexplained
+    by the last estimate suggest, per limb (:func:`occupose.proposals.limb_proposals`; 0 = none);
     filter_options : e.g. ``num_layers``
     """
 
@@ -190,7 +193,7 @@ class PoseEstimator:
         self.filter = make_filter(filter, problem, particles, rng, **filter_options)
         self.velocity_damping = velocity_damping
         self.proposals = proposals
-        self._has_arms = all(f"{side}_{name}" in problem.model.dof_names for side in SIDES for name in ARM_DOFS)
+        self._has_arms = "left_shoulder_flex" in problem.model.dof_names
         self._previous = None
 
     def initialise(self, pose: np.ndarray, spread: float | np.ndarray = 0.0) -> None:
@@ -232,9 +235,10 @@ class PoseEstimator:
         return self.filter.step(active=active, diffusion_scale=diffusion_scale)
 
     def _propose(self, current: np.ndarray, observation: Observation, active: np.ndarray | None) -> None:
-        """Set the DOFs of a random share of the particles to each arm proposal (models with
+        """Set the DOFs of a random share of the particles to each limb proposal (models with
         arms) and to the heading of the way walked, where every DOF set is active."""
-        proposals = arm_proposals(self.problem.model, current, observation) if self._has_arms else []
+        proposals = limb_proposals(self.problem.model, current, observation, legs=self.problem.standing,
+                                   floor=self.problem.floor) if self._has_arms else []
         if self.problem.walking is not None and self.problem.heading_dof is not None:
             proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
         proposals = [(dofs, values) for dofs, values in proposals if active is None or active[dofs].all()]

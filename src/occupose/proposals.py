@@ -1,4 +1,4 @@
-"""Data-driven arm proposals: a few particles try each arm where its points are.
+"""Data-driven limb proposals: a few particles try each arm and leg where its points are.
 
 An annealed search turns a limb by a few tenths of a radian per frame. An arm the filter
 has lost (left hanging while the person raised it, or left behind the torso where no
@@ -10,9 +10,15 @@ within reach of a shoulder (nearer that shoulder than the other). When an arm ha
 is taken as the hand, the arm reaches for it (:func:`reach_towards`: straight when the
 hand is out of reach, else bent with the elbow where the points are), and the arm's
 joint angles of that pose (the analytic inverse kinematics of
-:func:`occupose.body.arm_angles`) replace those of a share of the particles before
+:func:`occupose.body.limb_angles`) replace those of a share of the particles before
 the filter's step. The filter's weights decide: a proposal that does not explain the
 points better dies at the first resampling.
+
+Legs the same way, from their feet: a leg behind furniture (a chair's back) whose foot
+shows below it has few points of its own, and drifts where nothing is seen. The
+unexplained points less than :data:`FOOT_HEIGHT` above the floor nearer one hip than the
+other (across the floor) and within reach of it are that leg's foot: the ankle is
+put at their median, at the ankle's height, and the knee bends forwards.
 """
 
 from __future__ import annotations
@@ -20,52 +26,118 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from occupose.body import BodyModel, arm_angles, capsules_from_poses, joints_from_poses
+from occupose.body import LIMB_DOFS, BodyModel, capsules_from_poses, joints_from_poses, limb_angles
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation, point_distances
 
 #: Default distance, metres, beyond which a point is not explained by the estimate.
 UNEXPLAINED = 0.05
-#: Default least number of unexplained points that make an arm proposal.
+#: Default least number of unexplained points that make a limb proposal.
 MIN_POINTS = 10
 #: Reach of an arm beyond its upper arm + forearm (the hand), as a factor.
 REACH = 1.25
+#: Height, metres above the floor, below which unexplained points are taken as a foot.
+FOOT_HEIGHT = 0.2
+#: A leg is proposed only when its foot is farther than this from its ankle across the
+#: floor, metres: our legs have no feet, so the toes' points of a leg in the right place are
+#: unexplained too, and would pull its ankle forwards.
+FOOT_LOST = 0.15
 SIDES = ("left", "right")
-ARM_DOFS = ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")
-#: Places tried for the elbow of an arm that reaches a hand within its length.
+#: Joints of each limb from its root: (root, middle, end).
+LIMB_JOINTS = {"arm": ("shoulder", "elbow", "wrist"), "leg": ("hip", "knee", "ankle")}
+#: Places tried for the elbow (knee) of a limb that reaches its end within its length.
 ELBOW_CANDIDATES = 8
 
 
-def arm_dofs(model: BodyModel, side: str) -> np.ndarray:
-    """(4,) int64: the DOFs of ``side``'s arm that a proposal sets (shoulder flex, abd, rot
-    and elbow; a forearm twist is left to the filter)."""
-    return np.array([model.dof_names.index(f"{side}_{name}") for name in ARM_DOFS], np.int64)
+def limb_dofs(model: BodyModel, side: str, limb: str = "arm") -> np.ndarray:
+    """(4,) int64: the DOFs of ``side``'s ``limb`` that a proposal sets (an arm's shoulder
+    flex, abd, rot and elbow, a forearm twist left to the filter; a leg's hip flex, abd,
+    rot and knee)."""
+    return np.array([model.dof_names.index(f"{side}_{name}") for name in LIMB_DOFS[limb]], np.int64)
 
 
-def arm_proposals(model: BodyModel, pose: np.ndarray, observation: Observation, *,
-                  unexplained: float = UNEXPLAINED, min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The arm poses that the points unexplained by ``pose`` suggest.
-
-    model : the body model; pose : (D,) the current estimate; observation : the frame's
-    Observation (its points, world metres, and their blocks, shared with the likelihood)
-    Returns a list of (dofs (n,) int64, values (n,) float64), one per arm with evidence.
-    """
-    points = observation.points
-    if len(points) < min_points:
-        return []
+def unexplained_points(model: BodyModel, pose: np.ndarray, observation: Observation,
+                       unexplained: float = UNEXPLAINED) -> np.ndarray:
+    """(M, 3) the observation's points farther than ``unexplained`` metres from the surface
+    of ``pose`` (D,)."""
+    if len(observation.points) == 0:
+        return observation.points
     a, b = capsules_from_poses(model, pose[None])
     distance, _ = point_distances(a, b, model.capsule_radii, observation)
-    loose = points[distance[0] > unexplained]
+    return observation.points[distance[0] > unexplained]
+
+
+def limb_proposals(model: BodyModel, pose: np.ndarray, observation: Observation, *, legs: bool = True,
+                   floor: float | None = 0.0, unexplained: float = UNEXPLAINED,
+                   min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The arm and leg poses that the points unexplained by ``pose`` suggest.
+
+    model : the body model; pose : (D,) the current estimate; observation : the frame's
+    Observation (its points, world metres, and their blocks, shared with the likelihood);
+    legs : propose legs too (a model with legs and a ``floor``); floor : its height, metres
+    Returns a list of (dofs (4,) int64, values (4,) float64), one per limb with evidence.
+    """
+    points = observation.points
+    loose = unexplained_points(model, pose, observation, unexplained)
     if len(loose) < min_points:
         return []
     joints = joints_from_poses(model, pose[None])[0]
+    proposals = _arm_proposals(model, pose, joints, points, loose, min_points)
+    if legs and floor is not None and "left_hip_flex" in model.dof_names:
+        for side, ankle in feet(model, pose, loose, floor, min_points).items():
+            hip, thigh, shin = _limb(joints, side, "leg")
+            if np.linalg.norm(ankle[:2] - joints[JOINT_INDEX[f"{side}_ankle"], :2]) < FOOT_LOST:
+                continue
+            within = points[np.linalg.norm(points - hip, axis=1) < REACH * (thigh + shin)]
+            knee, ankle = reach_towards(hip, ankle, thigh, shin, within, bend=forward(model, pose))
+            proposals.append((limb_dofs(model, side, "leg"), limb_angles(model, pose, side, "leg", hip, knee, ankle)))
+    return proposals
+
+
+def feet(model: BodyModel, pose: np.ndarray, loose: np.ndarray, floor: float,
+         min_points: int = MIN_POINTS) -> dict[str, np.ndarray]:
+    """Where the feet that ``loose`` points (M, 3) show put the ankles: side -> (3,) metres.
+
+    A leg's foot is its ``min_points`` or more points less than :data:`FOOT_HEIGHT` above
+    ``floor``, nearer its hip than the other across the floor and within reach of it
+    (:data:`REACH` times the leg's length); its ankle is at their median, at the model's
+    ankle height. model : a model with legs; pose : (D,) the current estimate.
+    """
+    low = loose[loose[:, 2] < floor + FOOT_HEIGHT]
+    if len(low) < min_points:
+        return {}
+    joints = joints_from_poses(model, pose[None])[0]
+    hips = np.array([joints[JOINT_INDEX[f"{side}_hip"]] for side in SIDES])
+    nearer = np.argmin(np.linalg.norm(low[:, None, :2] - hips[None, :, :2], axis=2), axis=1)
+    found = {}
+    for s, side in enumerate(SIDES):
+        hip, thigh, shin = _limb(joints, side, "leg")
+        mine = (nearer == s) & (np.linalg.norm(low - hip, axis=1) < REACH * (thigh + shin))
+        if mine.sum() >= min_points:
+            found[side] = np.median(low[mine], axis=0)
+            found[side][2] = floor + model.dims.ankle_height
+    return found
+
+
+def forward(model: BodyModel, pose: np.ndarray) -> np.ndarray:
+    """(3,) the horizontal unit vector ``pose`` (D,) faces (its heading)."""
+    heading = pose[model.dof_names.index("heading")]
+    return np.array([np.cos(heading), np.sin(heading), 0.0])
+
+
+def _limb(joints: np.ndarray, side: str, limb: str) -> tuple[np.ndarray, float, float]:
+    """The root joint (3,) of ``side``'s ``limb`` and its two segments' lengths, metres."""
+    root, mid, end = (joints[JOINT_INDEX[f"{side}_{j}"]] for j in LIMB_JOINTS[limb])
+    return root, float(np.linalg.norm(mid - root)), float(np.linalg.norm(end - mid))
+
+
+def _arm_proposals(model, pose, joints, points, loose, min_points):
     shoulders = np.array([joints[JOINT_INDEX[f"{side}_shoulder"]] for side in SIDES])
     to_shoulder = np.linalg.norm(loose[:, None, :] - shoulders[None], axis=2)  # (M, 2)
     nearer = np.argmin(to_shoulder, axis=1)
     proposals = []
     for s, side in enumerate(SIDES):
-        shoulder, elbow, wrist = (joints[JOINT_INDEX[f"{side}_{j}"]] for j in ("shoulder", "elbow", "wrist"))
-        upper, fore = np.linalg.norm(elbow - shoulder), np.linalg.norm(wrist - elbow)
+        shoulder, upper, fore = _limb(joints, side, "arm")
         reach = to_shoulder[:, s]
         mine = (nearer == s) & (reach < REACH * (upper + fore)) & (reach > upper)
         if mine.sum() < min_points:
@@ -74,34 +146,43 @@ def arm_proposals(model: BodyModel, pose: np.ndarray, observation: Observation, 
         hand = loose[mine[np.argsort(reach[mine])[int(0.9 * (len(mine) - 1))]]]
         within = points[np.linalg.norm(points - shoulder, axis=1) < REACH * (upper + fore)]
         elbow, wrist = reach_towards(shoulder, hand, upper, fore, within)
-        proposals.append((arm_dofs(model, side), arm_angles(model, pose, side, shoulder, elbow, wrist)))
+        proposals.append((limb_dofs(model, side), limb_angles(model, pose, side, "arm", shoulder, elbow, wrist)))
     return proposals
 
 
-def reach_towards(shoulder: np.ndarray, hand: np.ndarray, upper: float, fore: float, points: np.ndarray,
-                  candidates: int = ELBOW_CANDIDATES) -> tuple[np.ndarray, np.ndarray]:
-    """(elbow, wrist) (3,) metres of an arm from ``shoulder`` reaching for ``hand``.
+def reach_towards(root: np.ndarray, end: np.ndarray, upper: float, lower: float, points: np.ndarray | None,
+                  candidates: int = ELBOW_CANDIDATES, bend: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(middle, end) (3,) metres of a limb from ``root`` reaching for ``end``: an arm's
+    elbow and wrist from its shoulder, a leg's knee and ankle from its hip.
 
-    upper, fore : segment lengths, metres; points : (N, 3) the person's points. Out of
-    reach, the arm is straight towards the hand. Within reach, the wrist is on the hand
-    and the elbow on its circle of possible places; of ``candidates`` places around it,
-    the one whose two segments lie nearest the points (mean distance of 5 samples along
-    each to the nearest point) wins.
+    upper, lower : segment lengths, metres; points : (N, 3) the person's points, or None
+    (nothing seen of the limb); bend : (3,) a direction the middle joint must lie along (a
+    knee bends forwards), or None. Out of reach, the limb is straight towards the end.
+    Within reach, its end is on ``end`` and the middle joint on its circle of possible
+    places; of ``candidates`` places around it (those with a positive component along
+    ``bend``, if any), the one whose two segments lie nearest the points (mean distance of
+    5 samples along each to the nearest point) wins; without points, the one farthest
+    along ``bend``.
     """
-    offset = hand - shoulder
+    offset = end - root
     distance = float(np.linalg.norm(offset))
     axis = offset / distance
-    if distance >= upper + fore:
-        return shoulder + upper * axis, shoulder + (upper + fore) * axis
-    along = (upper ** 2 - fore ** 2 + distance ** 2) / (2 * distance)
+    if distance >= upper + lower:
+        return root + upper * axis, root + (upper + lower) * axis
+    along = (upper ** 2 - lower ** 2 + distance ** 2) / (2 * distance)
     radius = np.sqrt(max(upper ** 2 - along ** 2, 0.0))
     side = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
     side /= np.linalg.norm(side)
     up = np.cross(side, axis)
     angles = np.linspace(0.0, 2 * np.pi, candidates, endpoint=False)
-    elbows = shoulder + along * axis + radius * (np.cos(angles)[:, None] * side + np.sin(angles)[:, None] * up)
+    around = np.cos(angles)[:, None] * side + np.sin(angles)[:, None] * up
+    if bend is not None and (around @ np.asarray(bend, float) > 0.0).any():
+        around = around[around @ np.asarray(bend, float) > 0.0]
+    middles = root + along * axis + radius * around
+    if points is None or len(points) == 0:
+        return middles[np.argmax(around @ np.asarray(bend, float)) if bend is not None else 0], end
     t = np.linspace(0.1, 0.9, 5)[None, :, None]
-    samples = np.concatenate([shoulder + t * (elbows[:, None] - shoulder),
-                              elbows[:, None] + t * (hand - elbows[:, None])], axis=1)  # (E, 10, 3)
+    samples = np.concatenate([root + t * (middles[:, None] - root),
+                              middles[:, None] + t * (end - middles[:, None])], axis=1)  # (E, 10, 3)
     nearest = cKDTree(points).query(samples.reshape(-1, 3))[0].reshape(samples.shape[:2])
-    return elbows[np.argmin(nearest.mean(axis=1))], hand
+    return middles[np.argmin(nearest.mean(axis=1))], end

@@ -64,6 +64,7 @@ from occupose.joints import NUM_JOINTS
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
 from occupose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.pose import PoseEstimator, PoseProblem
+from occupose.proposals import feet, unexplained_points
 from occupose.proportions import fit_proportions
 from occupose.synth import motion as procedural
 
@@ -305,13 +306,23 @@ class _Person:
         """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
         WALK_FRAMES estimates, weighted WALK_PRIOR nats from WALK_FROM + WALK_RAMP m/s up
         (linearly from 0 at WALK_FROM); None when slower or too new."""
-        if len(self.path) < WALK_FRAMES:
-            return None
-        velocity = (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
-        speed = float(np.hypot(*velocity))
+        velocity = self._velocity()
+        speed = 0.0 if velocity is None else float(np.hypot(*velocity))
         if speed <= WALK_FROM:
             return None
         return float(np.arctan2(velocity[1], velocity[0])), WALK_PRIOR * min(1.0, (speed - WALK_FROM) / WALK_RAMP)
+
+    def standing(self) -> bool:
+        """Whether the pelvis moved at most WALK_FROM m/s over the last WALK_FRAMES estimates
+        (PoseProblem.standing: the feet are on the floor)."""
+        velocity = self._velocity()
+        return velocity is not None and float(np.hypot(*velocity)) <= WALK_FROM
+
+    def _velocity(self) -> np.ndarray | None:
+        """(2,) m/s of the pelvis over the last WALK_FRAMES estimates; None for fewer."""
+        if len(self.path) < WALK_FRAMES:
+            return None
+        return (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
 
     def step(self) -> np.ndarray:
         """(2,) metres per frame: the pelvis's mean step over its last estimates with every
@@ -661,7 +672,7 @@ class Tracker:
         seen = observation_from_views(self._views(observation, depths, person.model), self.method.max_points)
         if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
             return person.estimate(False)
-        person.problem.walking = person.walking()
+        person.problem.walking, person.problem.standing = person.walking(), person.standing()
         pose = person.estimator.step(seen, active=active, diffusion_scale=scale)
         if person.occlusion is not None:
             person.occlusion.remember(pose)
@@ -670,7 +681,10 @@ class Tracker:
             legs = [side for side in ("left", "right") if hidden[f"{side}_thigh"]]
             shins = [side for side in ("left", "right") if hidden[f"{side}_shin"] and not hidden[f"{side}_thigh"]]
             if legs or shins:
-                pose = planted_legs(person.model, pose, legs, shins)
+                floor = person.problem.floor
+                shown = feet(person.model, pose, unexplained_points(person.model, pose, seen), floor) \
+                    if floor is not None and person.problem.standing else {}
+                pose = planted_legs(person.model, pose, legs, shins, shown)
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
         person.settle(pose)
         person.face_the_way_walked()

@@ -131,20 +131,28 @@ def _inside(model: BodyModel, pose: np.ndarray) -> np.ndarray:
     return pose
 
 
-def arm_angles(model: BodyModel, pose: np.ndarray, side: str, shoulder, elbow, wrist) -> np.ndarray:
-    """(4,) shoulder flex, abd, rot and elbow of ``side``'s ("left" or "right") arm that
-    point it from ``shoulder`` through ``elbow`` to ``wrist`` ((3,) world metres), in the
-    torso of ``pose`` (D,): the analytic solution of :func:`pose_from_joints` for one arm
-    (the rest of the pose kept), clipped just inside the limits as pose_from_joints does
-    (arm proposals put exactly on a limit tracked measurably worse: 10.7 against 7.0 cm on
-    mocap no_occlusion)."""
+#: The DOFs of each limb, after the side's prefix, in the order :func:`limb_angles` returns.
+LIMB_DOFS = {"arm": ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow"),
+             "leg": ("hip_flex", "hip_abd", "hip_rot", "knee")}
+
+
+def limb_angles(model: BodyModel, pose: np.ndarray, side: str, limb: str, root, mid, end) -> np.ndarray:
+    """(4,) angles of ``side``'s ("left" or "right") ``limb`` ("arm": shoulder flex, abd,
+    rot and elbow; "leg": hip flex, abd, rot and knee, see :data:`LIMB_DOFS`) that point it
+    from ``root`` (shoulder or hip) through ``mid`` (elbow or knee) to ``end`` (wrist or
+    ankle), (3,) world metres, in the torso of ``pose`` (D,): the analytic solution of
+    :func:`pose_from_joints` for one limb (the rest of the pose kept), clipped just inside
+    the limits as pose_from_joints does (arm proposals put exactly on a limit tracked
+    measurably worse: 10.7 against 7.0 cm on mocap no_occlusion)."""
+    if limb not in LIMB_DOFS:
+        raise ValueError(f"limb must be one of {', '.join(LIMB_DOFS)}, got {limb!r}")
     names = model.dof_names
     torso = _torso_rotation(pose[names.index("heading")], pose[names.index("trunk_lean")],
                             pose[names.index("trunk_side")] if "trunk_side" in names else 0.0)
-    dofs = [names.index(f"{side}_{name}") for name in ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow")]
+    dofs = [names.index(f"{side}_{name}") for name in LIMB_DOFS[limb]]
     s = 1.0 if side == "left" else -1.0
-    angles = _limb(torso, np.asarray(shoulder, float), np.asarray(elbow, float), np.asarray(wrist, float), s,
-                   leg=False, limits=model.limits[dofs[:2]])
+    angles = _limb(torso, np.asarray(root, float), np.asarray(mid, float), np.asarray(end, float), s,
+                   leg=limb == "leg", limits=model.limits[dofs[:2]])
     lo, hi = model.limits[dofs, 0], model.limits[dofs, 1]
     margin = 1e-6 * (hi - lo)
     return np.clip(angles, lo + margin, hi - margin)
