@@ -83,13 +83,18 @@ class _Motion:
 
     Segments are joint trajectories (T, 15, 3); :func:`occupose.synth.sequence.chain`
     joins them. Procedural segments use body dimensions measured on the real clips when
-    these are used, so a person's size does not change between segments.
+    these are used, so a person's size does not change between segments: the first real
+    clip sets them, and the procedural segments before it are built again with them (each
+    is kept as its actions on a builder that starts where the segment before it ends).
     """
 
     def __init__(self, use_mocap: bool, start_xy, heading: float, dims: pm.BodyDims):
         self.use_mocap = use_mocap
         self.dims = dims
+        self.start = (start_xy, heading)
         self.segments: list[np.ndarray] = [pm.joints_from_pose(pm.standing_pose(start_xy, heading, dims)[None], dims)]
+        #: per segment, the procedural actions that build it (None: a clip or given joints)
+        self.actions: list[Callable[[pm.MotionBuilder], pm.MotionBuilder] | None] = [None]
         self.headings: list[float | None] = [None]
         self.sources: set[str] = set()
 
@@ -103,39 +108,48 @@ class _Motion:
         last = None if seconds is None else first + int(round(seconds * FPS))
         joints = place(joints[first:last], fps=FPS)
         self.sources.add(f"mocap:{path.stem}")
-        if len(self.segments) == 1:  # the first real clip sets this person's body size
-            self.dims = pm.dims_from_joints(joints)
-            self.segments[0] = pm.joints_from_pose(
-                pm.standing_pose(self.segments[0][0, J["pelvis"], :2], facing(self.segments[0][0]), self.dims)[None],
-                self.dims)
+        if not any(source.startswith("mocap:") for source in self.sources - {f"mocap:{path.stem}"}):
+            self._resize(pm.dims_from_joints(joints))  # the first real clip sets this person's body size
         return joints
 
-    def _builder(self) -> pm.MotionBuilder:
-        last = self.segments[-1][-1]
+    def _resize(self, dims: pm.BodyDims) -> None:
+        """Go on with ``dims``: the start pose and every procedural segment so far rebuilt."""
+        self.dims = dims
+        self.segments[0] = pm.joints_from_pose(pm.standing_pose(*self.start, dims)[None], dims)
+        for i, actions in enumerate(self.actions):
+            if actions is not None:
+                self.segments[i] = actions(self._builder(self.segments[i - 1])).joints()[1:]
+
+    def _builder(self, before: np.ndarray | None = None) -> pm.MotionBuilder:
+        """A builder that starts where ``before`` (default: the last segment) ends."""
+        last = (self.segments[-1] if before is None else before)[-1]
         return pm.MotionBuilder(last[J["pelvis"], :2], float(facing(last)), self.dims, FPS)
 
-    def add(self, joints: np.ndarray, heading: float | None = None) -> _Motion:
+    def add(self, joints: np.ndarray, heading: float | None = None,
+            actions: Callable[[pm.MotionBuilder], pm.MotionBuilder] | None = None) -> _Motion:
         self.segments.append(joints)
         self.headings.append(heading)
+        self.actions.append(actions)
         return self
 
     def clip_or(self, name: str, procedural: Callable[[pm.MotionBuilder], pm.MotionBuilder],
                 heading: float | None = None, start_s: float = 0.0, seconds: float | None = None) -> _Motion:
         """Add a slice of the real clip ``name``, or the procedural actions when absent."""
         joints = self._clip(name, start_s, seconds)
-        if joints is None:
-            self.sources.add("procedural")
-            builder = self._builder()
+        if joints is not None:
+            return self.add(joints, heading)
+
+        def actions(builder: pm.MotionBuilder) -> pm.MotionBuilder:
             if heading is not None and abs(math.remainder(heading - builder.pose[pm.HEADING], math.tau)) > 0.05:
                 builder.turn(heading)
-            joints = procedural(builder).joints()[1:]
-            heading = None
-        return self.add(joints, heading)
+            return procedural(builder)
+
+        return self.procedural(actions)
 
     def procedural(self, actions: Callable[[pm.MotionBuilder], pm.MotionBuilder]) -> _Motion:
         """Add procedural actions that start from the current pose (exact positions)."""
         self.sources.add("procedural")
-        return self.add(actions(self._builder()).joints()[1:])
+        return self.add(actions(self._builder()).joints()[1:], actions=actions)
 
     def joints(self, num_frames: int, skip: int = 0) -> np.ndarray:
         """The chained trajectory without its first ``skip`` frames, cut or held (last
