@@ -3,6 +3,7 @@ evaluation end to end (no_occlusion, 20 procedural frames, `ours`) through the c
 
 import csv
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,8 +11,8 @@ from click.testing import CliRunner
 
 from occupose.cli import main
 from occupose.evaluate import (
-    RunResult, evaluate, hidden_share, intervals_from_mask, mean_row, per_joint_table, report_markdown,
-    results_table, table_rows, write_results_csv,
+    RunResult, evaluate, hidden_share, intervals_from_mask, mean_row, per_joint_table, render_recording,
+    report_markdown, results_table, table_rows, write_results_csv,
 )
 from occupose.joints import JOINTS
 from occupose.metrics import PersonScore, Score, TableRow
@@ -177,3 +178,22 @@ def test_evaluate_reuses_the_recording_and_runs_in_workers_as_in_process(evaluat
     assert sum(n for n, _ in seen) == 3 * FRAMES and {t for _, t in seen} == {3 * FRAMES}
     assert [(r.scenario, r.method, r.seed) for r in result.runs] == [("no_occlusion", "ours", 0), ("no_occlusion", "ours", 1)]
     assert (out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv").read_text() == in_process
+
+
+def test_a_recording_of_motion_the_scenario_no_longer_makes_is_rendered_again(tmp_path, monkeypatch):
+    from occupose.synth import scenarios
+
+    out = tmp_path / "no_occlusion"
+    render_recording("no_occlusion", out, 3, procedural=True)
+    stamp = (out / "recording.json").stat().st_mtime_ns
+    render_recording("no_occlusion", out, 3, procedural=True)
+    assert (out / "recording.json").stat().st_mtime_ns == stamp  # the same: kept
+    build = scenarios.build_scenario
+
+    def moved(*args, **kwargs):  # the same settings, the person 1 cm further along x
+        built = build(*args, **kwargs)
+        return replace(built, people=tuple(replace(p, joints=p.joints + [0.01, 0.0, 0.0]) for p in built.people))
+
+    monkeypatch.setattr(scenarios, "build_scenario", moved)
+    render_recording("no_occlusion", out, 3, procedural=True)
+    assert (out / "recording.json").stat().st_mtime_ns != stamp

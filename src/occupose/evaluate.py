@@ -29,6 +29,7 @@ left out of those, and FAILs), and its status is FAIL when *any* run FAILs.
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import multiprocessing
@@ -129,7 +130,8 @@ def _positive_int(value, what: str) -> int:
 def render_recording(scenario: str, out: Path, frames: int | None, procedural: bool,
                      progress: Callable[[int], None] | None = None) -> Path:
     """Render ``scenario`` (scene seed SCENE_SEED) into the recording folder ``out``, or
-    keep the one already there when it was rendered with the same settings.
+    keep the one already there when it was rendered with the same settings and the same
+    ground-truth motion.
 
     frames : at most this many frames (None: all); procedural : never use mocap clips.
     An existing folder rendered differently (or half-written) is replaced.
@@ -139,8 +141,10 @@ def render_recording(scenario: str, out: Path, frames: int | None, procedural: b
 
     built = build_scenario(scenario, seed=SCENE_SEED, use_mocap=not procedural)
     total = built.num_frames if frames is None else min(frames, built.num_frames)
+    # the ground truth's digest: a recording of motion the scenario no longer makes is stale
+    truth = hashlib.sha1(b"".join(np.ascontiguousarray(p.joints[:total]).tobytes() for p in built.people))
     info = {"scenario": scenario, "seed": SCENE_SEED, "frames": total, "motion_source": built.motion_source,
-            "events": {k: list(v) for k, v in built.events.items()}}
+            "events": {k: list(v) for k, v in built.events.items()}, "truth": truth.hexdigest()}
     marker = out / RENDER_INFO
     if marker.is_file() and (out / "recording.json").is_file():
         try:
