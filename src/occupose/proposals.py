@@ -14,11 +14,13 @@ joint angles of that pose (the analytic inverse kinematics of
 the filter's step. The filter's weights decide: a proposal that does not explain the
 points better dies at the first resampling.
 
-Legs the same way, from their feet: a leg behind furniture (a chair's back) whose foot
-shows below it has few points of its own, and drifts where nothing is seen. The
-unexplained points less than :data:`FOOT_HEIGHT` above the floor nearer one hip than the
-other (across the floor) and within reach of it are that leg's foot: the ankle is
-put at their median, at the ankle's height, and the knee bends forwards.
+Legs the same way, from their feet (:func:`feet`), for a person who stands (a walker's
+foot leaves the floor): a leg behind furniture (a chair's back) whose foot shows below it
+has few points of its own, and drifts where nothing is seen. The unexplained points less
+than :data:`FOOT_HEIGHT` above the floor nearer one hip than the other (across the floor)
+and within reach of it are that leg's foot: when it is more than :data:`FOOT_LOST` from
+the leg's ankle, the ankle is put at their median, at the ankle's height, and the knee
+bends forwards.
 """
 
 from __future__ import annotations

@@ -107,9 +107,9 @@ class _Motion:
         first = int(round(start_s * FPS))
         last = None if seconds is None else first + int(round(seconds * FPS))
         joints = place(joints[first:last], fps=FPS)
-        self.sources.add(f"mocap:{path.stem}")
-        if not any(source.startswith("mocap:") for source in self.sources - {f"mocap:{path.stem}"}):
+        if not any(source.startswith("mocap:") for source in self.sources):
             self._resize(pm.dims_from_joints(joints))  # the first real clip sets this person's body size
+        self.sources.add(f"mocap:{path.stem}")
         return joints
 
     def _resize(self, dims: pm.BodyDims) -> None:
