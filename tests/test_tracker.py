@@ -21,13 +21,16 @@ from occupose.synth.scenarios import build_scenario
 from occupose.tracker import (
     CARRY_FRAMES,
     INIT_FRAMES,
+    LATER_SPEED,
     METHODS,
     PROPORTION_EVERY,
     PROPORTION_FRAMES,
+    START_CHECK_S,
     WALK_FRAMES,
     WALK_FROM,
     WALK_PRIOR,
     WALK_RAMP,
+    WALKING_SPEED,
     Tracker,
     _Person,
     track_frames,
@@ -414,6 +417,23 @@ def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
     assert person.walking() is None and person.standing()
 
 
+@pytest.mark.parametrize("speed, estimates, turned", [(1.2, 100, True), (0.5, 100, False), (0.5, 10, True)])
+def test_a_person_walking_backwards_is_turned_round_at_the_start_or_when_walking_fast(speed, estimates, turned):
+    """The estimate faces +x while the path goes along -x: turned round (heading + pi) at
+    a walk above WALKING_SPEED in the first START_CHECK_S seconds, later only above
+    LATER_SPEED (a person turning to sit down still shows the way it came)."""
+    assert WALKING_SPEED < 0.5 < LATER_SPEED < 1.2 and 10 <= START_CHECK_S * 30 < 100
+    model = body_model("full")
+    person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.estimates, person.since_turn = pose, estimates, CARRY_FRAMES
+    person.path = [np.array([-speed / 30.0 * i, 0.0]) for i in range(CARRY_FRAMES)]
+    person.face_the_way_walked()
+    heading = person.pose[model.dof_names.index("heading")]
+    assert abs(abs(heading) - np.pi) < 1e-9 if turned else heading == 0.0
+
+
 def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     model = body_model("full")
     person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
@@ -437,21 +457,24 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     """The estimates of a person walking into occlusion stall at the cabinet's edge: the
     carry takes its step from the last estimates with every part in view (while they are
     recent), and a person suspended on its blob while walking comes back where it was
-    carried to, not at its blob's centroid (which stays at the edge)."""
+    carried to, not at its blob's centroid (which stays at the edge). The estimates in
+    full view need not follow one another: the step is over the estimates in between."""
     model = body_model("full")
     person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
     pose = standing_pose(model, (0.0, 0.0), 0.0)
     person.estimator.initialise(pose, 0.0)
     person.centroid = np.array([0.0, 0.0, 1.0])
-    for i in range(10):  # in full view, 1.2 m/s along +x
+    shin = model.part_names.index("right_shin")
+    for i in range(10):  # in full view, 1.2 m/s along +x, but for a shin counted hidden twice
+        person.part_visible[shin] = i not in (4, 5)
         person.settle(pose + np.eye(model.num_dofs)[0] * 0.04 * i)
-    person.part_visible[model.part_names.index("right_shin")] = False
+    person.part_visible[shin] = False
     for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s
         person.settle(pose + np.eye(model.num_dofs)[0] * (0.36 + 0.01 * (i + 1)))
     np.testing.assert_allclose(person.step(), [0.04, 0.0])
     person.carry()
     np.testing.assert_allclose(person.pose[:2], [0.45, 0.0])
-    person.walked_on = True  # suspended on its blob while walking
+    assert person.walked_on  # carried at 1.2 m/s: it comes back there, not on its blob
     person.come_back(np.array([0.9, 0.3, 1.0]))
     np.testing.assert_allclose(person.pose[:2], [0.45, 0.0])
     np.testing.assert_allclose(person.estimator.filter.estimate[:2], [0.45, 0.0])
@@ -459,3 +482,11 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     for _ in range(CARRY_FRAMES):  # standing partly hidden for long: its own recent path again
         person.settle(person.pose)
     np.testing.assert_allclose(person.step(), [0.0, 0.0], atol=1e-12)
+    person.carry()
+    assert not person.walked_on  # carried standing: it comes back on its blob
+    person.come_back(np.array([0.9, 0.3, 1.0]))
+    np.testing.assert_allclose(person.pose[:2], np.array([0.9, 0.3]) + person.anchor)
+    person.part_visible[:] = True
+    for i in range(3):  # in full view again, 0.6 m/s along -y: the walk before is too old to count
+        person.settle(person.pose - np.eye(model.num_dofs)[1] * 0.02)
+    np.testing.assert_allclose(person.step(), [0.0, -0.02], atol=1e-12)

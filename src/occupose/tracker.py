@@ -162,7 +162,10 @@ MAX_ANCHOR = 0.25
 #: walks more than BACKWARDS (radians) away from the way it faces is turned round.
 WALKING_SPEED = 0.3
 BACKWARDS = np.deg2rad(135.0)
+#: In its first START_CHECK_S seconds at WALKING_SPEED, later only at LATER_SPEED, m/s (a
+#: person turning round to sit down still shows the way it came in its recent path).
 START_CHECK_S = 2.0
+LATER_SPEED = 0.7
 #: A walking person faces the way it walks: frames over which the way is taken, the nats
 #: that facing backwards costs at full speed, and the speeds (m/s) from which the prior
 #: starts and over which it ramps up to full weight (see _Person.walking). A person
@@ -234,13 +237,12 @@ class _Person:
         self.lost = False  # gone or suspended since the last estimate
         self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
         self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
-        self.clear: list[np.ndarray] = []  # the same of those with every part in view,
-        self.since_clear = 0  # and the estimates since the last of them
-        self.walked_on = False  # carried while suspended on its blob (come_back)
+        self.clear: list[tuple[int, np.ndarray]] = []  # (estimate's number, x, y) of those with every part in view
+        self.walked_on = False  # carried at a walker's speed since the last estimate (come_back)
         self.part_visible = np.ones(model.num_parts, bool)
         self.fps = fps
         self.since_turn = 0  # estimates since the last turn round (face_the_way_walked)
-        self.estimates = 0  # estimates since the start
+        self.estimates = 0  # estimates since the start (settle)
         self.in_view = 0  # estimates with every part in view (learn_proportions)
         self.kept: list[tuple[np.ndarray, Observation]] = []  # (pose, observation) for the next fit
         self.fits = 0  # proportion fits done
@@ -251,29 +253,30 @@ class _Person:
         anchor = pose[:2] - self.centroid[:2]  # a partly hidden blob's centroid is off: clipped
         self.anchor = anchor * min(1.0, MAX_ANCHOR / max(float(np.hypot(*anchor)), 1e-12))
         self.path = (self.path + [pose[:2].copy()])[-CARRY_FRAMES:]
-        self.since_clear += 1
+        self.estimates += 1
         if self.part_visible.all():
-            self.clear, self.since_clear = (self.clear + [pose[:2].copy()])[-CARRY_FRAMES:], 0
+            self.clear = (self.clear + [(self.estimates, pose[:2].copy())])[-CARRY_FRAMES:]
 
     def face_the_way_walked(self) -> None:
-        """In a person's first START_CHECK_S seconds, turn the whole estimate round (heading +
-        pi) when the person has walked faster than WALKING_SPEED over the last CARRY_FRAMES
-        estimates in a direction more than BACKWARDS from the way it faces, at most once
-        per CARRY_FRAMES. A body of round cones fits its points about as well facing either
-        way, and the blob's velocity a person starts with can be off (the grid extracts a
-        body over its first frames, and the centroid moves with it), so a person may start
-        facing backwards. Only at the start: later, a person who turns round to sit down
-        still shows the way it came in its recent path."""
+        """Turn the whole estimate round (heading + pi) when the person has walked faster
+        than WALKING_SPEED (in its first START_CHECK_S seconds; later LATER_SPEED) over the
+        last CARRY_FRAMES estimates in a direction more than BACKWARDS from the way it
+        faces, at most once per CARRY_FRAMES. A body of round cones fits its points about
+        as well facing either way, and the blob's velocity a person starts with can be off
+        (the grid extracts a body over its first frames, and the centroid moves with it),
+        so a person may start facing backwards; and an estimate may not follow a person who
+        turns round on the spot (enter_exit_occlusion: facing the old way for 100 frames
+        while walking back). Slower walks count only at the start: later, a person who
+        turns round to sit down still shows the way it came in its recent path."""
         self.since_turn += 1
-        self.estimates += 1
-        if (len(self.path) < CARRY_FRAMES or self.since_turn < CARRY_FRAMES
-                or self.estimates > START_CHECK_S * self.fps):
+        if len(self.path) < CARRY_FRAMES or self.since_turn < CARRY_FRAMES:
             return
         velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps
         heading = self.problem.heading_dof
         facing = self.pose[heading]
         off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
-        if np.hypot(*velocity) > WALKING_SPEED and abs(off) > BACKWARDS:
+        fast = WALKING_SPEED if self.estimates <= START_CHECK_S * self.fps else LATER_SPEED
+        if np.hypot(*velocity) > fast and abs(off) > BACKWARDS:
             turn = np.zeros(self.model.num_dofs)
             turn[heading] = np.pi
             self.estimator.shift(turn)
@@ -325,29 +328,39 @@ class _Person:
         return (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
 
     def step(self) -> np.ndarray:
-        """(2,) metres per frame: the pelvis's mean step over its last estimates with every
-        part in view when the last of them is at most CARRY_FRAMES estimates old, else over
-        its last estimates; at most CARRY_SPEED. A person walking behind a cabinet is
+        """(2,) metres per frame: the pelvis's mean step over its last CARRY_FRAMES estimates,
+        over those with every part in view when there are two; at most CARRY_SPEED. A person walking behind a cabinet is
         estimated on what is left in view, which stalls at the cabinet's edge: those last
-        estimates fall behind (0.6 against 1 m/s in enter_exit_occlusion)."""
-        path = self.clear if len(self.clear) > 1 and self.since_clear <= CARRY_FRAMES else self.path
-        if len(path) < 2:
+        estimates fall behind (0.6 against 1 m/s in enter_exit_occlusion). The estimates in
+        full view among the last CARRY_FRAMES need not follow one another (a leg counted
+        hidden for a few frames in between): their step is over the estimates between the
+        first and the last of them."""
+        recent = [(n, xy) for n, xy in self.clear if n > self.estimates - CARRY_FRAMES]
+        if len(recent) > 1:
+            (first, start), (last, end) = recent[0], recent[-1]
+            step = (end - start) / (last - first)
+        elif len(self.path) > 1:
+            step = (self.path[-1] - self.path[0]) / (len(self.path) - 1)
+        else:
             return np.zeros(2)
-        step = (path[-1] - path[0]) / (len(path) - 1)
         return step * min(1.0, CARRY_SPEED / max(float(np.hypot(*step)), 1e-12))
 
     def carry(self) -> None:
-        """A frame without an estimate (gone or suspended): the pose walks on at :meth:`step`."""
+        """A frame without an estimate (gone or suspended): the pose walks on at :meth:`step`;
+        at a walker's speed (above WALK_FROM) it comes back where it was carried to
+        (:meth:`come_back`)."""
+        step = self.step()
         self.pose = self.pose.copy()
-        self.pose[:2] += self.step()
+        self.pose[:2] += step
         self.lost = True
+        self.walked_on = float(np.hypot(*step)) * self.fps > WALK_FROM
 
     def come_back(self, centroid: np.ndarray) -> None:
         """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
-        plus the anchor, or where it was carried to if it walked on while suspended on
-        this blob (the centroid of a body coming out from behind a cabinet stays at the
-        cabinet's edge). The particles are where the last estimate left them, not where
-        the pose was carried since, so they are shifted from the estimate. The path is moved
+        plus the anchor, or where it was carried to if it was carried at a walker's speed
+        (:meth:`carry`: the centroid of a body coming out from behind a cabinet lags at the
+        cabinet's edge, whether its blob was kept or had gone). The particles are where the last estimate left them, not where
+        the pose was carried since, so they are shifted from the estimate. The paths are moved
         along (the jump onto the blob is no step of the person's): the way it walked before
         goes on, so a person hidden again soon after is carried on that way."""
         place = self.pose[:2] if self.walked_on else centroid[:2] + self.anchor
@@ -358,7 +371,9 @@ class _Person:
         self.pose[:2] = place
         self.centroid, self.lost, self.walked_on = centroid, False, False
         if self.path:
-            self.path = [p + (self.pose[:2] - self.path[-1]) for p in self.path]
+            moved = self.pose[:2] - self.path[-1]
+            self.path = [p + moved for p in self.path]
+            self.clear = [(n, p + moved) for n, p in self.clear]
 
     def estimate(self, fresh: bool) -> PersonEstimate:
         joints = joints_of(self.model, self.pose)
@@ -528,7 +543,6 @@ class Tracker:
         for pid, person in self.people.items():
             if pid not in out:  # gone (behind something): kept, not estimated
                 person.carry()
-                person.walked_on = False  # back on whatever blob it is seen on
                 out[pid] = person.estimate(False)
         self._tick("pose", clock)
         return dict(sorted(out.items()))
@@ -663,7 +677,6 @@ class Tracker:
                 # (at the image's edge it stays with its blob: the camera cannot show it walk on)
                 if np.hypot(*person.step()) * self.fps > WALK_FROM and not self._at_border(observation):
                     person.carry()
-                    person.walked_on = True
                 else:
                     person.pose, person.lost = moved, True
                 return person.estimate(False)
