@@ -162,8 +162,8 @@ MAX_ANCHOR = 0.25
 #: walks more than BACKWARDS (radians) away from the way it faces is turned round.
 WALKING_SPEED = 0.3
 BACKWARDS = np.deg2rad(135.0)
-#: In its first START_CHECK_S seconds at WALKING_SPEED, later only at LATER_SPEED, m/s (a
-#: person turning round to sit down still shows the way it came in its recent path).
+#: A person is turned round at WALKING_SPEED in its first START_CHECK_S seconds, later only
+#: at LATER_SPEED, m/s (one turning round to sit down still shows the way it came).
 START_CHECK_S = 2.0
 LATER_SPEED = 0.7
 #: A walking person faces the way it walks: frames over which the way is taken, the nats
@@ -237,7 +237,8 @@ class _Person:
         self.lost = False  # gone or suspended since the last estimate
         self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
         self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
-        self.clear: list[tuple[int, np.ndarray]] = []  # (estimate's number, x, y) of those with every part in view
+        # (estimate's number, pelvis x, y) of those of them with every part in view
+        self.clear: list[tuple[int, np.ndarray]] = []
         self.walked_on = False  # carried at a walker's speed since the last estimate (come_back)
         self.part_visible = np.ones(model.num_parts, bool)
         self.fps = fps
@@ -329,12 +330,12 @@ class _Person:
 
     def step(self) -> np.ndarray:
         """(2,) metres per frame: the pelvis's mean step over its last CARRY_FRAMES estimates,
-        over those with every part in view when there are two; at most CARRY_SPEED. A person walking behind a cabinet is
-        estimated on what is left in view, which stalls at the cabinet's edge: those last
-        estimates fall behind (0.6 against 1 m/s in enter_exit_occlusion). The estimates in
-        full view among the last CARRY_FRAMES need not follow one another (a leg counted
-        hidden for a few frames in between): their step is over the estimates between the
-        first and the last of them."""
+        over those with every part in view when there are two; at most CARRY_SPEED. A
+        person walking behind a cabinet is estimated on what is left in view, which stalls
+        at the cabinet's edge: those last estimates fall behind (0.6 against 1 m/s in
+        enter_exit_occlusion). The estimates in full view need not follow one another (a
+        leg counted hidden for a few frames in between): their step is over the estimates
+        from the first of them to the last."""
         recent = [(n, xy) for n, xy in self.clear if n > self.estimates - CARRY_FRAMES]
         if len(recent) > 1:
             (first, start), (last, end) = recent[0], recent[-1]
@@ -359,10 +360,11 @@ class _Person:
         """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
         plus the anchor, or where it was carried to if it was carried at a walker's speed
         (:meth:`carry`: the centroid of a body coming out from behind a cabinet lags at the
-        cabinet's edge, whether its blob was kept or had gone). The particles are where the last estimate left them, not where
-        the pose was carried since, so they are shifted from the estimate. The paths are moved
-        along (the jump onto the blob is no step of the person's): the way it walked before
-        goes on, so a person hidden again soon after is carried on that way."""
+        cabinet's edge, whether its blob was kept or had gone). The particles are where the
+        last estimate left them, not where the pose was carried since, so they are shifted
+        from the estimate. The paths are moved along (the jump onto the blob is no step of
+        the person's): the way it walked before goes on, so a person hidden again soon after
+        is carried on that way."""
         place = self.pose[:2] if self.walked_on else centroid[:2] + self.anchor
         offset = np.zeros(self.model.num_dofs)
         offset[:2] = place - self.estimator.filter.estimate[:2]
