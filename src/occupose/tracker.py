@@ -26,7 +26,7 @@ A frame:
    walks (the speed of its last estimates in full view, while recent) and is not at the
    image's edge, else moved with its blob; one whose blob is gone is kept and carried at
    that speed; either is placed back on its blob when seen again (where it was carried to,
-   if it walked on with its blob in view), keeping the way it walked (a new blob track near
+   if it was carried at a walker's speed), keeping the way it walked (a new blob track near
    it is its); it ends when its blob has been gone for longer than ``max_gap_s``.
 
 With ``upcoming`` frames, step 1 of the next frame runs on a second thread during step 4.
