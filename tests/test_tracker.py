@@ -20,6 +20,7 @@ from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.tracker import (
     CARRY_FRAMES,
+    GATE_M,
     INIT_FRAMES,
     LATER_SPEED,
     METHODS,
@@ -401,6 +402,31 @@ def test_a_blob_whose_own_points_stay_below_a_seated_head_does_not_start(trackin
     assert len(chair.points) > 1000
     assert not _tries_to_start(tracking, monkeypatch, chair, 1.5)
     assert _tries_to_start(tracking, monkeypatch, observation, 1.5)  # the whole body does
+
+
+def test_points_far_from_the_predicted_body_are_left_out_of_the_likelihood(tracking):
+    """The validation gate: pixels of the person's blob whose points are farther than GATE_M
+    from its predicted body (a chair it carries) are not given to the likelihood; its own
+    are. Without a predicted body (a new person) every pixel is."""
+    tracker, depths = tracking
+    person, observation = tracker.people[1], tracker._previous[1]
+    cam = tracker.cameras[0].name
+    own = observation.pixels[cam]
+    # a carried box: pixels beside the person's, its points 0.55 .. 0.75 m in front of the
+    # pelvis, at the pelvis's height
+    box = np.setdiff1d(np.arange(own.max() + 1, own.max() + 400, 2), own)
+    heading = person.pose[person.model.dof_names.index("heading")]
+    ahead = np.linspace(0.55, 0.75, len(box))
+    box_points = person.pose[:3] + np.column_stack([ahead * np.cos(heading), ahead * np.sin(heading),
+                                                    np.linspace(-0.1, 0.1, len(box))])
+    carried = GridObservation(1, {cam: np.concatenate([own, box])},
+                              {cam: np.concatenate([observation.camera_points[cam], box_points])})
+    assert person.body_distance()(box_points).min() > GATE_M
+    mask = tracker._views(carried, depths, person.model, person.body_distance())[0].mask.ravel()
+    assert not mask[box].any()
+    assert mask[own].mean() > 0.98  # measured 1.0: the walker's estimate fits its points
+    everything = tracker._views(carried, depths, person.model)[0].mask.ravel()
+    assert everything[box].all() and everything[own].all()
 
 
 def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():

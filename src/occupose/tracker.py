@@ -185,6 +185,14 @@ PROPORTION_FITS = 3
 #: The upper-body model sees only the points above this share of the person's stature
 #: (the hips are at about 0.53).
 UPPER_CUT = 0.5
+#: A person's points farther than this from its predicted body (the last estimate moved
+#: with its blob), metres, are left out of its likelihood (a validation gate): what a
+#: person carries, or a piece of something else in its blob, is not its body. The points
+#: term pulls the nearest part onto every point, so without the gate the legs reach into
+#: a chair being carried (moved_chair: the left ankle 48 cm off for 4 s, in every method).
+#: A limb that moved faster than the gate between two frames comes back over a few frames,
+#: its points nearest the body first.
+GATE_M = 0.25
 #: A new blob track within this distance of a lost person's carried pelvis is that
 #: person's, metres (horizontal).
 REJOIN_M = 1.0
@@ -375,16 +383,16 @@ class _Person:
         if self.path:
             moved = self.pose[:2] - self.path[-1]
             self.path = [p + moved for p in self.path]
-            self.clear = [(n, p + moved) for n, p in self.clear]
 
     def estimate(self, fresh: bool) -> PersonEstimate:
         joints = joints_of(self.model, self.pose)
         visible = np.array([fresh and bool(len(p)) and bool(self.part_visible[p].all()) for p in self.joint_parts])
         return PersonEstimate(joints, visible & np.isfinite(joints[:, 0]))
 
-    def body_distance(self):
-        """f(points (N, 3)) -> (N,) metres to the surface of this person's current body."""
-        a, b = capsules_from_poses(self.model, self.pose[None])
+    def body_distance(self, pose: np.ndarray | None = None):
+        """f(points (N, 3)) -> (N,) metres to the surface of this person's body in ``pose``
+        (D,) (default: its current pose)."""
+        a, b = capsules_from_poses(self.model, (self.pose if pose is None else pose)[None])
         radii = self.model.capsule_radii
 
         def distance(points: np.ndarray) -> np.ndarray:
@@ -582,15 +590,21 @@ class Tracker:
         self.seconds[stage] += now - start
         return now
 
-    def _views(self, observation, depths, model: BodyModel) -> list[View]:
+    def _views(self, observation, depths, model: BodyModel, near=None) -> list[View]:
         """The likelihood's views of a person: its pixels in each camera, for the upper-body
         model only those above UPPER_CUT of its stature (as the second paper thresholds its
-        top-view images: the model has no legs, and leg points pull its hanging arms down)."""
+        top-view images: the model has no legs, and leg points pull its hanging arms down).
+
+        near : f(points (N, 3) metres) -> (N,) metres to the person's predicted body, or None
+            (a new person); given, only the pixels whose points are within GATE_M of it
+        """
         views = []
         for camera in self.cameras:
-            pixels = observation.pixels[camera.name]
+            pixels, points = observation.pixels[camera.name], observation.camera_points[camera.name]
+            keep = np.ones(len(pixels), bool) if near is None or not len(pixels) else near(points) < GATE_M
             if model.name == "upper":
-                pixels = pixels[observation.camera_points[camera.name][:, 2] >= UPPER_CUT * model.dims.height]
+                keep &= points[:, 2] >= UPPER_CUT * model.dims.height
+            pixels = pixels[keep]
             mask = np.zeros(camera.height * camera.width, bool)
             mask[pixels] = True
             views.append(View(camera, depths[camera.name], mask.reshape(camera.height, camera.width)))
@@ -684,7 +698,8 @@ class Tracker:
                 return person.estimate(False)
             active, scale = person.occlusion.active_dofs(), person.occlusion.diffusion_scale()
             person.problem.hidden_parts = ~person.part_visible
-        seen = observation_from_views(self._views(observation, depths, person.model), self.method.max_points)
+        seen = observation_from_views(self._views(observation, depths, person.model, person.body_distance(moved)),
+                                      self.method.max_points)
         if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
             return person.estimate(False)
         person.problem.walking, person.problem.standing = person.walking(), person.standing()
