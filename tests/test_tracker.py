@@ -479,34 +479,36 @@ def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])
 
 
-def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view():
+def test_a_person_walking_behind_a_cabinet_is_carried_at_its_blobs_speed_in_full_view():
     """The estimates of a person walking into occlusion stall at the cabinet's edge: the
-    carry takes its step from the last estimates with every part in view (while they are
-    recent), and a person suspended on its blob while walking comes back where it was
+    carry takes its step from the blob's velocity at the last estimates with every part in
+    view (while they are recent; the median, so the first frames of the blob being cut do
+    not count), and a person suspended on its blob while walking comes back where it was
     carried to, not at its blob's centroid (which stays at the edge). The estimates in
-    full view need not follow one another: the step is over the estimates in between."""
+    full view need not follow one another."""
     model = body_model("full")
     person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
     pose = standing_pose(model, (0.0, 0.0), 0.0)
     person.estimator.initialise(pose, 0.0)
     person.centroid = np.array([0.0, 0.0, 1.0])
     shin = model.part_names.index("right_shin")
-    for i in range(10):  # in full view, 1.2 m/s along +x, but for a shin counted hidden twice
-        person.part_visible[shin] = i not in (4, 5)
-        person.settle(pose + np.eye(model.num_dofs)[0] * 0.04 * i)
+    for i in range(10):  # in full view, the blob at 1.2 m/s along +x (the last two: being cut),
+        person.part_visible[shin] = i not in (4, 5)  # but for a shin counted hidden twice; the
+        blob = [1.2, 0.0] if i < 8 else [0.7, 0.1]  # estimates lag, at 0.6 m/s
+        person.settle(pose + np.eye(model.num_dofs)[0] * 0.02 * i, np.array(blob))
     person.part_visible[shin] = False
-    for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s
-        person.settle(pose + np.eye(model.num_dofs)[0] * (0.36 + 0.01 * (i + 1)))
+    for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s, the blob stalls
+        person.settle(pose + np.eye(model.num_dofs)[0] * (0.18 + 0.01 * (i + 1)), np.array([0.2, 0.0]))
     np.testing.assert_allclose(person.step(), [0.04, 0.0])
     person.carry()
-    np.testing.assert_allclose(person.pose[:2], [0.45, 0.0])
+    np.testing.assert_allclose(person.pose[:2], [0.27, 0.0])
     assert person.walked_on  # carried at 1.2 m/s: it comes back there, not on its blob
     person.come_back(np.array([0.9, 0.3, 1.0]))
-    np.testing.assert_allclose(person.pose[:2], [0.45, 0.0])
-    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [0.45, 0.0])
+    np.testing.assert_allclose(person.pose[:2], [0.27, 0.0])
+    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [0.27, 0.0])
     assert not person.walked_on and not person.lost
     for _ in range(CARRY_FRAMES):  # standing partly hidden for long: its own recent path again
-        person.settle(person.pose)
+        person.settle(person.pose, np.array([0.3, 0.0]))
     np.testing.assert_allclose(person.step(), [0.0, 0.0], atol=1e-12)
     person.carry()
     assert not person.walked_on  # carried standing: it comes back on its blob
@@ -514,5 +516,5 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     np.testing.assert_allclose(person.pose[:2], np.array([0.9, 0.3]) + person.anchor)
     person.part_visible[:] = True
     for i in range(3):  # in full view again, 0.6 m/s along -y: the walk before is too old to count
-        person.settle(person.pose - np.eye(model.num_dofs)[1] * 0.02)
+        person.settle(person.pose - np.eye(model.num_dofs)[1] * 0.02, np.array([0.0, -0.6]))
     np.testing.assert_allclose(person.step(), [0.0, -0.02], atol=1e-12)
