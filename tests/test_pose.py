@@ -31,7 +31,16 @@ from occupose.body import body_model, capsules_from_poses, joints_from_poses, po
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import View, observation_from_views
 from occupose.metrics import frame_errors, is_fail, joint_errors, table_row
-from occupose.pose import FLOOR_COST, FLOOR_SLACK, PoseEstimator, PoseProblem, default_stages
+from occupose.pose import (
+    FLOOR_COST,
+    FLOOR_SLACK,
+    REACH_COST,
+    REACH_SLACK,
+    PoseEstimator,
+    PoseProblem,
+    add_reach_term,
+    default_stages,
+)
 from occupose.synth.generate import frames, person_observations
 from occupose.synth.motion import dims_from_joints
 from occupose.synth.scenarios import build_scenario
@@ -156,6 +165,39 @@ def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
     np.testing.assert_allclose(without[1] - values[1], expected, atol=1e-9)
     with pytest.raises(ValueError, match="floor must be a finite height"):
         PoseProblem(model, floor=float("nan"))
+
+
+def test_a_hip_higher_than_its_leg_reaches_costs_even_with_the_legs_hidden(walk):
+    """The reach term: the person of the walk, lifted 20 cm (its feet off the floor), costs
+    its torso REACH_COST per metre its lower hip is above a straight leg's reach plus
+    REACH_SLACK, also when its legs are hidden (they ride along with the pelvis); standing,
+    nothing."""
+    gt, observations = walk
+    model = body_model("full", dims=dims_from_joints(gt))
+    problem, free = PoseProblem(model), PoseProblem(model, floor=None)
+    for p in (problem, free):
+        p.set_observation(observations[10])
+    pose = pose_from_joints(model, gt[10])
+    lifted = pose.copy()
+    lifted[model.dof("z")] += 0.2
+    torso = model.part_names.index("torso")
+    a, _ = capsules_from_poses(model, lifted[None])
+    thighs = [c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("thigh")]
+    reach = model.dims.thigh + model.dims.shin + model.capsule_radii[model.part_names.index("left_shin"), 1]
+    expected = REACH_COST * (a[0, thighs, 2].min() - reach - REACH_SLACK)
+    assert expected > 0.05 * REACH_COST
+    for hidden in (False, True):
+        for p in (problem, free):
+            p.hidden_parts = np.array(["thigh" in n or "shin" in n for n in model.part_names]) & hidden
+        values, without = problem.log_likelihood(np.array([pose, lifted])), free.log_likelihood(np.array([pose, lifted]))
+        assert np.array_equal(values[0], without[0])
+        np.testing.assert_allclose((without - values)[1], np.eye(len(model.part_names))[torso] * expected, atol=1e-9)
+    upper = body_model("upper")
+    floating = standing_pose(upper, (0.0, 0.0))
+    floating[upper.dof("z")] += 1.0
+    out = np.zeros((1, len(upper.part_names)))
+    add_reach_term(upper, capsules_from_poses(upper, floating[None])[0], 0.0, out)
+    assert not out.any()  # no legs, no reach
 
 
 def test_part_weights_chain_weighs_each_group_by_its_chain_to_the_root():

@@ -24,6 +24,14 @@ PROPOSAL_SHARE = 0.1
 #: not object: without this a leg left with no points of its own sinks into the floor.
 FLOOR_SLACK = 0.03
 FLOOR_COST = 20.0
+#: The reach term (see PoseProblem): a hip higher above the floor than its straight leg
+#: reaches, plus REACH_SLACK metres, costs the root's part REACH_COST nats per metre beyond.
+#: Feet stand on the floor. A leg hidden behind furniture keeps its last configuration and
+#: rides along with the pelvis, so nothing else holds the body down: behind a couch or a
+#: chair the visible trunk, free to slide along its axis, rose 10-25 cm to fit a head
+#: larger than the model's (walk_behind_couch, gesture_behind_chair).
+REACH_SLACK = 0.05
+REACH_COST = 50.0
 
 
 class PoseProblem:
@@ -38,7 +46,8 @@ class PoseProblem:
     part_weights : how the part-based filter weights each of ``model.weight_groups``, a
         key of :data:`PART_WEIGHTS` (see :func:`chain_weight_groups`)
     floor : height of the floor, world metres (DESIGN: z = 0), below which a part costs
-        :data:`FLOOR_COST` nats per metre; None for no floor
+        :data:`FLOOR_COST` nats per metre, and above which a hip cannot be higher than its
+        leg reaches (:func:`add_reach_term`); None for no floor
     """
 
     def __init__(self, model: BodyModel, likelihood: str = "points+free", *, fps: float = 30.0,
@@ -102,6 +111,7 @@ class PoseProblem:
                                         len(self.model.part_names))
         if self.floor is not None:
             add_floor_term(self.model, a, b, self.floor, out)
+            add_reach_term(self.model, a, self.floor, out)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
@@ -117,6 +127,22 @@ def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float,
     sunk = np.maximum(floor - FLOOR_SLACK - lowest, 0.0)
     if sunk.any():
         np.add.at(out.T, model.capsule_part, -FLOOR_COST * sunk.T)
+
+
+def add_reach_term(model: BodyModel, a: np.ndarray, floor: float, out: np.ndarray) -> None:
+    """Add the reach term to per-part log-likelihoods ``out`` (P, K), in place: where the
+    lower hip (the thighs' top ends, from capsule ends a (P, C, 3) world metres) is higher
+    above ``floor`` than a straight leg reaches (thigh + shin + the shin's bottom radius)
+    plus REACH_SLACK, the root's part costs REACH_COST nats per metre beyond. A model
+    without legs gets nothing."""
+    thighs = [c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("thigh")]
+    shin = next((c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("shin")), None)
+    if not thighs or shin is None:
+        return
+    reach = model.dims.thigh + model.dims.shin + model.capsule_radii[shin, 1]
+    over = np.maximum(a[:, thighs, 2].min(axis=1) - floor - reach - REACH_SLACK, 0.0)
+    root_part = model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]]
+    out[:, root_part] -= REACH_COST * over
 
 
 def _moved_parts(model: BodyModel, dofs: np.ndarray) -> np.ndarray:
