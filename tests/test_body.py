@@ -463,6 +463,9 @@ def test_root_drift():
     previous = standing_pose(m, (0.0, 0.0))
     current = standing_pose(m, (0.04, -0.02), heading=0.1)
     drift = root_drift(m, previous, current, damping=0.5)
-    np.testing.assert_allclose(drift[:3], [0.02, -0.01, 0.0], atol=1e-12)
-    assert not drift[3:].any()
+    np.testing.assert_allclose(drift[:4], [0.02, -0.01, 0.0, 0.05], atol=1e-12)
+    assert not drift[4:].any()
+    # the turn goes the shorter way round, through +-pi
+    turned = root_drift(m, standing_pose(m, (0.0, 0.0), heading=3.1), standing_pose(m, (0.0, 0.0), heading=-3.1))
+    assert turned[m.dof("heading")] == pytest.approx(2 * np.pi - 6.2)
 

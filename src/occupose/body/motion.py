@@ -2,7 +2,7 @@
 
 The prediction of a particle filter moves each pose by independent Gaussian noise per DOF
 (standard deviations ``scales``, per frame) plus an optional deterministic ``drift`` (a
-constant-velocity term for the root, :func:`root_drift`). Limits are kept by one of
+constant-velocity term for the root's position and heading, :func:`root_drift`). Limits are kept by one of
 :data:`BOUNDARY_MODES`:
 
 - ``reflect``: a value past a limit is folded back inside (mirror at the limits; several
@@ -137,9 +137,12 @@ def diffuse(poses, scales, limits, rng: np.random.Generator, *, periodic=None, m
 
 
 def root_drift(model: BodyModel, previous, current, damping: float = 1.0) -> np.ndarray:
-    """Constant-velocity drift (D,) for :func:`diffuse`: the root's translation between the
-    two last estimates ``previous`` and ``current`` (D,), times ``damping`` in [0, 1];
-    zero for every other DOF."""
+    """Constant-velocity drift (D,) for :func:`diffuse`: the root's translation and turn
+    (its periodic DOFs: the heading, the shorter way round) between the two last estimates
+    ``previous`` and ``current`` (D,), times ``damping`` in [0, 1]; zero for every other
+    DOF. The turn carries a person turning on the spot on through the half turn where
+    the body, seen side-on, fits as well turning back (enter_exit_occlusion: the estimate
+    fell 90 degrees behind and then turned back the other way)."""
     previous = np.asarray(previous, dtype=np.float64)
     current = np.asarray(current, dtype=np.float64)
     if previous.shape != (model.num_dofs,) or current.shape != (model.num_dofs,):
@@ -150,4 +153,6 @@ def root_drift(model: BodyModel, previous, current, damping: float = 1.0) -> np.
     drift = np.zeros(model.num_dofs)
     root = model.dof_type == TRANSLATION
     drift[root] = damping * (current[root] - previous[root])
+    turn = model.periodic
+    drift[turn] = damping * ((current[turn] - previous[turn] + math.pi) % (2 * math.pi) - math.pi)
     return drift
