@@ -8,6 +8,8 @@ frames; the tracker keeps one per track.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
@@ -135,14 +137,25 @@ def add_reach_term(model: BodyModel, a: np.ndarray, floor: float, out: np.ndarra
     above ``floor`` than a straight leg reaches (thigh + shin + the shin's bottom radius)
     plus REACH_SLACK, the root's part costs REACH_COST nats per metre beyond. A model
     without legs gets nothing."""
-    thighs = [c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("thigh")]
-    shin = next((c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("shin")), None)
-    if not thighs or shin is None:
+    legs = _leg_reach(model)
+    if legs is None:
         return
-    reach = model.dims.thigh + model.dims.shin + model.capsule_radii[shin, 1]
+    thighs, reach, root_part = legs
     over = np.maximum(a[:, thighs, 2].min(axis=1) - floor - reach - REACH_SLACK, 0.0)
-    root_part = model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]]
     out[:, root_part] -= REACH_COST * over
+
+
+@functools.lru_cache(maxsize=64)
+def _leg_reach(model: BodyModel) -> tuple[np.ndarray, float, int] | None:
+    """(the thighs' capsules, a straight leg's reach in metres, the root's part) of
+    ``model``, or None without legs (cached: the likelihood is evaluated many times a frame)."""
+    part = [model.part_names[k] for k in model.capsule_part]
+    thighs = np.array([c for c, name in enumerate(part) if name.endswith("thigh")])
+    shin = next((c for c, name in enumerate(part) if name.endswith("shin")), None)
+    if not len(thighs) or shin is None:
+        return None
+    reach = model.dims.thigh + model.dims.shin + float(model.capsule_radii[shin, 1])
+    return thighs, reach, int(model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]])
 
 
 def _moved_parts(model: BodyModel, dofs: np.ndarray) -> np.ndarray:
