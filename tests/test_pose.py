@@ -189,7 +189,8 @@ def test_a_hip_higher_than_its_leg_reaches_costs_even_with_the_legs_hidden(walk)
     for hidden in (False, True):
         for p in (problem, free):
             p.hidden_parts = np.array(["thigh" in n or "shin" in n for n in model.part_names]) & hidden
-        values, without = problem.log_likelihood(np.array([pose, lifted])), free.log_likelihood(np.array([pose, lifted]))
+        poses = np.array([pose, lifted])
+        values, without = problem.log_likelihood(poses), free.log_likelihood(poses)
         assert np.array_equal(values[0], without[0])
         np.testing.assert_allclose((without - values)[1], np.eye(len(model.part_names))[torso] * expected, atol=1e-9)
     upper = body_model("upper")

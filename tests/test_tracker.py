@@ -20,6 +20,7 @@ from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.tracker import (
     CARRY_FRAMES,
+    GATE_KEEP,
     GATE_M,
     INIT_FRAMES,
     LATER_SPEED,
@@ -407,7 +408,8 @@ def test_a_blob_whose_own_points_stay_below_a_seated_head_does_not_start(trackin
 def test_points_far_from_the_predicted_body_are_left_out_of_the_likelihood(tracking):
     """The validation gate: pixels of the person's blob whose points are farther than GATE_M
     from its predicted body (a chair it carries) are not given to the likelihood; its own
-    are. Without a predicted body (a new person) every pixel is."""
+    are. Without a predicted body (a new person), or with one so far off that the gate
+    would leave fewer than GATE_KEEP of them, every pixel is."""
     tracker, depths = tracking
     person, observation = tracker.people[1], tracker._previous[1]
     cam = tracker.cameras[0].name
@@ -422,11 +424,17 @@ def test_points_far_from_the_predicted_body_are_left_out_of_the_likelihood(track
     carried = GridObservation(1, {cam: np.concatenate([own, box])},
                               {cam: np.concatenate([observation.camera_points[cam], box_points])})
     assert person.body_distance()(box_points).min() > GATE_M
+    assert len(box) < (1 - GATE_KEEP) * len(own)  # the box is a small share: the gate applies
     mask = tracker._views(carried, depths, person.model, person.body_distance())[0].mask.ravel()
     assert not mask[box].any()
     assert mask[own].mean() > 0.98  # measured 1.0: the walker's estimate fits its points
     everything = tracker._views(carried, depths, person.model)[0].mask.ravel()
     assert everything[box].all() and everything[own].all()
+    # a prediction 1 m off would keep none of the person's points: the gate stands aside
+    off = person.pose.copy()
+    off[0] += 1.0
+    assert person.body_distance(off)(carried.camera_points[cam]).min() > GATE_M
+    assert tracker._views(carried, depths, person.model, person.body_distance(off))[0].mask.ravel()[own].all()
 
 
 def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():

@@ -20,11 +20,12 @@ A frame:
    fully in view for a few frames (body size from their points, a search over headings
    facing where it walks or the camera, standing or sitting); a known one first runs the
    occlusion check (its previous estimate moved to the blob's new centre of mass), then
-   the filter on the visible subtree; hidden legs (and hidden shins under seen thighs) are placed
-   with their feet on the floor;
+   the filter on the visible subtree, given only its points near that predicted body (not
+   what it carries); hidden legs (and hidden shins under seen thighs) are placed with
+   their feet on the floor;
 5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
-   walks (the speed of its last estimates in full view, while recent) and is not at the
-   image's edge, else moved with its blob; one whose blob is gone is kept and carried at
+   walks (its blob's velocity at its last estimates in full view, while recent) and is not
+   at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
    that speed; either is placed back on its blob when seen again (where it was carried to,
    if it was carried at a walker's speed), keeping the way it walked (a new blob track near
    it is its); it ends when its blob has been gone for longer than ``max_gap_s``.
@@ -191,8 +192,11 @@ UPPER_CUT = 0.5
 #: term pulls the nearest part onto every point, so without the gate the legs reach into
 #: a chair being carried (moved_chair: the left ankle 48 cm off for 4 s, in every method).
 #: A limb that moved faster than the gate between two frames comes back over a few frames,
-#: its points nearest the body first.
+#: its points nearest the body first. A camera's points are all kept when the gate would
+#: leave fewer than GATE_KEEP of them: the prediction itself is off (a person back from
+#: behind a cabinet a step away from where it was carried), and would never be corrected.
 GATE_M = 0.25
+GATE_KEEP = 0.5
 #: A new blob track within this distance of a lost person's carried pelvis is that
 #: person's, metres (horizontal).
 REJOIN_M = 1.0
@@ -599,11 +603,15 @@ class Tracker:
 
         near : f(points (N, 3) metres) -> (N,) metres to the person's predicted body, or None
             (a new person); given, only the pixels whose points are within GATE_M of it
+            (all of a camera's when that leaves fewer than GATE_KEEP of them)
         """
         views = []
         for camera in self.cameras:
             pixels, points = observation.pixels[camera.name], observation.camera_points[camera.name]
-            keep = np.ones(len(pixels), bool) if near is None or not len(pixels) else near(points) < GATE_M
+            keep = np.ones(len(pixels), bool)
+            if near is not None and len(pixels):
+                gated = near(points) < GATE_M
+                keep = gated if gated.mean() >= GATE_KEEP else keep
             if model.name == "upper":
                 keep &= points[:, 2] >= UPPER_CUT * model.dims.height
             pixels = pixels[keep]

@@ -2,8 +2,8 @@
 
 The prediction of a particle filter moves each pose by independent Gaussian noise per DOF
 (standard deviations ``scales``, per frame) plus an optional deterministic ``drift`` (a
-constant-velocity term for the root's position and heading, :func:`root_drift`). Limits are kept by one of
-:data:`BOUNDARY_MODES`:
+constant-velocity term for the root's position and heading, :func:`root_drift`). Limits
+are kept by one of :data:`BOUNDARY_MODES`:
 
 - ``reflect``: a value past a limit is folded back inside (mirror at the limits; several
   folds for a very large step), which keeps the density continuous at the limit;
