@@ -24,8 +24,8 @@ A frame:
    what it carries); hidden legs (and hidden shins under seen thighs) are placed with
    their feet on the floor;
 5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
-   walks (its blob's velocity at its last estimates in full view, while recent) and is not
-   at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
+   walks (the speed of its last estimates in full view, while recent, or its blob's then)
+   and is not at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
    that speed; either is placed back on its blob when seen again (where it was carried to,
    if it was carried at a walker's speed), keeping the way it walked (a new blob track near
    it is its); it ends when its blob has been gone for longer than ``max_gap_s``.
@@ -151,9 +151,9 @@ INIT_STEPS = 3
 INIT_SPREAD = (0.05, 0.05, 0.05, 0.15, 0.1)
 #: Seconds a track survives without its blob.
 MAX_GAP_S = 3.0
-#: A person gone or suspended walks on at its blob's velocity at its estimates in full view
-#: among this many last ones (else its pelvis's mean velocity over them: _Person.step), at
-#: most CARRY_SPEED metres per frame (2 m/s at 30 fps).
+#: A person gone or suspended walks on at the speed of its estimates in full view among
+#: this many last ones, or at its blob's then, whichever is faster (else its pelvis's mean
+#: velocity over them: _Person.step), at most CARRY_SPEED metres per frame (2 m/s at 30 fps).
 CARRY_FRAMES = 15
 CARRY_SPEED = 0.067
 #: Largest horizontal offset between the pelvis and its blob's centroid kept for placing
@@ -249,8 +249,9 @@ class _Person:
         self.lost = False  # gone or suspended since the last estimate
         self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
         self.path: list[np.ndarray] = []  # pelvis x, y of the last CARRY_FRAMES estimates
-        # (estimate's number, its blob's velocity (2,) m/s) of those of them with every part in view
-        self.clear: list[tuple[int, np.ndarray]] = []
+        # (estimate's number, pelvis x, y, its blob's velocity (2,) m/s) of those of them with
+        # every part in view
+        self.clear: list[tuple[int, np.ndarray, np.ndarray]] = []
         self.walked_on = False  # carried at a walker's speed since the last estimate (come_back)
         self.part_visible = np.ones(model.num_parts, bool)
         self.fps = fps
@@ -268,7 +269,7 @@ class _Person:
         self.path = (self.path + [pose[:2].copy()])[-CARRY_FRAMES:]
         self.estimates += 1
         if self.part_visible.all():
-            self.clear = (self.clear + [(self.estimates, np.array(velocity, float))])[-CARRY_FRAMES:]
+            self.clear = (self.clear + [(self.estimates, pose[:2].copy(), np.array(velocity, float))])[-CARRY_FRAMES:]
 
     def face_the_way_walked(self) -> None:
         """Turn the whole estimate round (heading + pi) when the person has walked faster
@@ -341,19 +342,25 @@ class _Person:
         return (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
 
     def step(self) -> np.ndarray:
-        """(2,) metres per frame: the median velocity of its blob at the last CARRY_FRAMES
-        estimates that had every part in view, when there are two of them; else the
-        pelvis's mean step over its last CARRY_FRAMES estimates; at most CARRY_SPEED. A
-        person walking behind a cabinet is estimated on what is left in view, which stalls
-        at the cabinet's edge: those last estimates fall behind (0.6 against 1 m/s in
-        enter_exit_occlusion). The estimates in full view fall behind too, by chance, when
-        the person started shortly before (its first estimates settling): their step
-        over 0.3 s gave 0.6-0.8 m/s for a 1 m/s walk in some runs, the blob's velocity
-        (measured on all its cells, at every frame) 1.0; its median leaves out the frames
-        where the blob was already being cut by the cabinet."""
-        recent = [velocity for n, velocity in self.clear if n > self.estimates - CARRY_FRAMES]
+        """(2,) metres per frame: the faster of two measures of its walk over its last
+        CARRY_FRAMES estimates with every part in view, when there are two of them: their
+        mean step (from the first to the last; they need not follow one another) and their
+        blob's median velocity; else the pelvis's mean step over its last CARRY_FRAMES
+        estimates; at most CARRY_SPEED. A person walking behind a cabinet is estimated on
+        what is left in view, which stalls at the cabinet's edge: those last estimates
+        fall behind (0.6 against 1 m/s in enter_exit_occlusion). Each measure falls short
+        where the other does not: the estimates just after a person starts are still
+        settling (0.6-0.8 m/s for a 1 m/s walk in some runs, the blob 1.0), and the blob's
+        velocity, smoothed by the blob tracker, lags a person speeding up (0.7 m/s for a
+        walker reaching 1 m/s after turning round on the spot: the whole enter_exit scene
+        FAILed in 3 of 3 runs with the blob's alone); the median leaves out the frames where
+        the blob was already being cut."""
+        recent = [(n, xy, velocity) for n, xy, velocity in self.clear if n > self.estimates - CARRY_FRAMES]
         if len(recent) > 1:
-            step = np.median(recent, axis=0) / self.fps
+            (first, start, _), (last, end, _) = recent[0], recent[-1]
+            walked = (end - start) / (last - first)
+            blob = np.median([velocity for _, _, velocity in recent], axis=0) / self.fps
+            step = max(walked, blob, key=lambda s: float(np.hypot(*s)))
         elif len(self.path) > 1:
             step = (self.path[-1] - self.path[0]) / (len(self.path) - 1)
         else:
@@ -389,6 +396,7 @@ class _Person:
         if self.path:
             moved = self.pose[:2] - self.path[-1]
             self.path = [p + moved for p in self.path]
+            self.clear = [(n, p + moved, v) for n, p, v in self.clear]
 
     def estimate(self, fresh: bool) -> PersonEstimate:
         joints = joints_of(self.model, self.pose)
