@@ -148,6 +148,20 @@ def test_block_pruning_is_exact_on_a_body(front, rng):
     assert np.mean(capsule == want_capsule[:, whole.position]) > 0.999
 
 
+def test_unsorted_blocks_give_the_same_distances(front, rng):
+    """sort=False (the gate's: image-order runs, no median splits) changes the blocks, not
+    the distances."""
+    from occupose.likelihood._capsules import blocked_points
+
+    obs, pose = front
+    a, b, radii, _, _ = _model_capsules(FULL, pose[None] + rng.normal(size=(3, FULL.num_dofs)) * 0.05)
+    runs = blocked_points(obs.points, block_size=50, sort=False)
+    assert np.array_equal(runs.block_start[:-1] // 64, np.arange(len(runs.block_start) - 1))  # 50 padded to 64
+    np.testing.assert_array_equal(runs.position[:50], np.arange(50))
+    np.testing.assert_allclose(point_distances(a, b, radii, obs.points, sort=False)[0],
+                               point_distances(a, b, radii, obs.points)[0], atol=1e-6)
+
+
 def _blocks_reference(points, block_size):
     """Index sets of the median splits (lower half first), by NumPy partitioning."""
     leaves, stack = [], [np.arange(len(points))]

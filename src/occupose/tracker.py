@@ -410,7 +410,7 @@ class _Person:
         radii = self.model.capsule_radii
 
         def distance(points: np.ndarray) -> np.ndarray:
-            return point_distances(a, b, radii, points)[0][0].astype(np.float64)
+            return point_distances(a, b, radii, points, sort=False)[0][0].astype(np.float64)
 
         return distance
 

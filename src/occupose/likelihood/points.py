@@ -28,12 +28,14 @@ from occupose.likelihood.observation import Observation
 POINTS_SCALE = 0.01
 
 
-def point_distances(a, b, radii, points) -> tuple[np.ndarray, np.ndarray]:
+def point_distances(a, b, radii, points, *, sort: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Distance from each point to the nearest capsule surface, per particle.
 
     a, b : (P, C, 3) float, metres, world: round-cone ends; radii : (C, 2) float, metres
     points : (N, 3) float, metres, world, or an Observation (whose blocks of points are
         reused)
+    sort : for an (N, 3) array, whether to sort the points into compact blocks first
+        (:func:`blocked_points`); False for points in image order and few particles
     Returns distance (P, N) float32, metres (absolute distance to the round cone's
     surface; float32, exact to about a micrometre) and capsule (P, N) int32, the index of
     the nearest capsule (the first one on ties).
@@ -45,7 +47,7 @@ def point_distances(a, b, radii, points) -> tuple[np.ndarray, np.ndarray]:
         points = np.asarray(points, dtype=np.float64)
         if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
             raise ValueError(f"points must be a finite (N, 3) array, got shape {points.shape}")
-        blocks = blocked_points(points)
+        blocks = blocked_points(points, sort=sort)
     blocked_distance = np.empty((a.shape[0], len(blocks.px)), np.float32)
     blocked_capsule = np.empty((a.shape[0], len(blocks.px)), np.int32)
     _kernels.nearest_capsules(a, b, radii, *blocks.kernel_args, blocked_distance, blocked_capsule)
