@@ -143,6 +143,11 @@ class Camera:
         """(3,) float64, metres, world frame: the camera's optical centre."""
         return self.world_from_camera[:3, 3].copy()
 
+    @property
+    def down_angle(self) -> float:
+        """Radians the optical axis points below the horizontal (world z up; negative: up)."""
+        return float(np.arcsin(np.clip(-self.world_from_camera[2, 2], -1.0, 1.0)))
+
     def to_dict(self) -> dict[str, Any]:
         """The camera as a ``recording.json`` camera entry (plain JSON types, keys in CAMERA_KEYS order)."""
         return {

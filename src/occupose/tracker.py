@@ -54,8 +54,8 @@ from occupose.body import (
     joints_from_poses,
     pose_from_joints,
 )
-from occupose.body.size import top_height
-from occupose.camera import Camera
+from occupose.body.size import TOP_RANK, breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
+from occupose.camera import Camera, points_from_depth
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.observation import observations_from_depth, predicted_from_tracks
@@ -66,7 +66,6 @@ from occupose.likelihood import Observation, View, observation_from_views, point
 from occupose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.pose import PoseEstimator, PoseProblem
 from occupose.proposals import feet, unexplained_points
-from occupose.proportions import fit_proportions
 from occupose.synth import motion as procedural
 
 
@@ -84,12 +83,9 @@ class Method:
         no part of the upper body)
     model : "full", "upper" or "auto" (``upper`` for a camera looking steeply down)
     max_points : most observed points per person and frame given to the likelihood
-    proportions : fit each person's shoulder and hip widths to their first frames with every
-        part in view (occupose.proportions). Off by default: on the 8 full-body scenarios x
-        3 runs it took ``ours`` from 8.9 to 8.0 cm where the person's shoulders are 0.6 of
-        the average (no_occlusion), but made it worse where they are average and something
-        else is in the person's points (moved_chair, carrying a chair: 11.6 -> 13.6 cm),
-        9.4 -> 9.7 cm on average.
+    shape : measure each person's neck height and shoulder width on its first estimates
+        seen from the front or the back, and resize its model once (the full model only;
+        :meth:`_Person.learn_shape`)
     """
 
     filter: str
@@ -99,7 +95,7 @@ class Method:
     occlusion: bool = False
     model: str = "auto"
     max_points: int = 1000
-    proportions: bool = False
+    shape: bool = True
 
     @property
     def filter_options(self) -> dict:
@@ -176,13 +172,16 @@ WALK_FRAMES = 15
 WALK_PRIOR = 1.0
 WALK_FROM = 0.5
 WALK_RAMP = 0.4
-#: With Method.proportions, a person's body widths are fitted (occupose.proportions) to
-#: every PROPORTION_EVERY-th estimate with every part in view, PROPORTION_FRAMES of them at a
-#: time (1 s at 30 fps), PROPORTION_FITS times: each fit starts from poses estimated with
-#: the last fit's widths.
-PROPORTION_EVERY = 3
-PROPORTION_FRAMES = 10
-PROPORTION_FITS = 3
+#: With Method.shape, a person's neck depth below the top of its head and its shoulder
+#: breadth are measured (occupose.body.size.neck_and_shoulders) on SHAPE_FRAMES of its
+#: estimates with the trunk, head and arms in view and upright (lean under SHAPE_LEAN
+#: radians) that a camera looking at most SHAPE_LEVEL radians down sees from the front or
+#: the back (facing within SHAPE_FRONTAL radians of its line of sight or away); their
+#: medians then resize its model, once.
+SHAPE_FRAMES = 6
+SHAPE_LEAN = 0.3
+SHAPE_LEVEL = np.deg2rad(35.0)
+SHAPE_FRONTAL = np.deg2rad(37.0)
 #: The upper-body model sees only the points above this share of the person's stature
 #: (the hips are at about 0.53).
 UPPER_CUT = 0.5
@@ -207,8 +206,7 @@ START_CLEARANCE = 0.5
 
 def _model_for(cameras: Sequence[Camera]) -> str:
     """'upper' when every camera looks down more steeply than STEEP_DOWN, else 'full'."""
-    steep = [np.arcsin(np.clip(-c.world_from_camera[2, 2], -1, 1)) > STEEP_DOWN for c in cameras]
-    return "upper" if all(steep) else "full"
+    return "upper" if all(c.down_angle > STEEP_DOWN for c in cameras) else "full"
 
 
 @dataclass
@@ -257,9 +255,8 @@ class _Person:
         self.fps = fps
         self.since_turn = 0  # estimates since the last turn round (face_the_way_walked)
         self.estimates = 0  # estimates since the start (settle)
-        self.in_view = 0  # estimates with every part in view (learn_proportions)
-        self.kept: list[tuple[np.ndarray, Observation]] = []  # (pose, observation) for the next fit
-        self.fits = 0  # proportion fits done
+        self.shapes: list[tuple[float, float]] = []  # (neck depth, shoulder breadth) metres (learn_shape)
+        self.shaped = not (method.shape and model.name == "full")  # resized, or never to be
 
     def settle(self, pose: np.ndarray, velocity: np.ndarray) -> None:
         """Take a new estimate (D,); velocity (2,) m/s: its blob's horizontal velocity."""
@@ -297,27 +294,37 @@ class _Person:
             self.pose = self.estimator.filter.estimate.copy()
             self.since_turn = 0
 
-    def learn_proportions(self, observation: Observation) -> None:
-        """With Method.proportions: keep every PROPORTION_EVERY-th estimate with every part
-        in view and its ``observation``; with PROPORTION_FRAMES kept, fit the body's widths
-        to them and go on with a model of those widths (the particles moved so that the
-        estimate keeps its joints), at most PROPORTION_FITS times."""
-        if not self.method.proportions or self.fits >= PROPORTION_FITS or not self.part_visible.all():
+    def learn_shape(self, observation: Observation) -> None:
+        """With Method.shape: measure the neck depth and shoulder breadth
+        (occupose.body.size.neck_and_shoulders) in the first of ``observation``'s views
+        that sees this estimate from the front or the back (SHAPE_FRONTAL, SHAPE_LEVEL;
+        trunk, head and arms in view, upright); with SHAPE_FRAMES measurements, go on with a model
+        of their medians (occupose.body.size.dims_with_shoulders; the particles moved so
+        that the estimate keeps its joints)."""
+        upper = [self.model.part_names.index(p) for p in self.model.part_names if not p.endswith(("thigh", "shin"))]
+        if self.shaped or not self.part_visible[upper].all() or abs(self.pose[self.model.dof("trunk_lean")]) > SHAPE_LEAN:
             return
-        self.in_view += 1
-        if self.in_view % PROPORTION_EVERY:
+        heading = self.pose[self.problem.heading_dof]
+        for view in observation.views:
+            ray = self.pose[:2] - view.camera.position[:2]
+            square = abs(np.cos(heading) * ray[0] + np.sin(heading) * ray[1]) / max(float(np.hypot(*ray)), 1e-9)
+            if view.camera.down_angle > SHAPE_LEVEL or square < np.cos(SHAPE_FRONTAL):
+                continue
+            points = points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0]
+            measured = neck_and_shoulders(breadth_profile(points)) if len(points) >= TOP_RANK else None
+            if measured is not None:
+                self.shapes.append(measured)
+                break
+        if len(self.shapes) < SHAPE_FRAMES:
             return
-        self.kept.append((self.pose.copy(), observation))
-        if len(self.kept) < PROPORTION_FRAMES:
-            return
-        poses, observations = zip(*self.kept)
-        fit = fit_proportions(self.model, np.array(poses), observations, likelihood=self.method.likelihood,
-                              floor=self.problem.floor)
-        self.model = body_model(self.model.name, fit.dims, self.model.girth)
-        self.problem.resize(self.model)
-        self.estimator.shift(fit.pose - self.pose)
-        self.pose = fit.pose
-        self.kept, self.fits = [], self.fits + 1
+        depth, breadth = np.median(self.shapes, axis=0)
+        model = body_model(self.model.name, dims_with_shoulders(self.model.dims, self.model.girth, depth, breadth),
+                           self.model.girth)
+        pose = pose_from_joints(model, joints_of(self.model, self.pose), refine=False)
+        self.model = model
+        self.problem.resize(model)
+        self.estimator.shift(pose - self.pose)
+        self.pose, self.shaped = pose, True
 
     def walking(self) -> tuple[float, float] | None:
         """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
@@ -736,7 +743,7 @@ class Tracker:
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
         person.settle(pose, self.blobs.states[tid].velocity)
         person.face_the_way_walked()
-        person.learn_proportions(seen)
+        person.learn_shape(seen)
         return person.estimate(True)
 
 
