@@ -22,7 +22,8 @@ A frame:
    occlusion check (its previous estimate moved to the blob's new centre of mass), then
    the filter on the visible subtree, given only its points near that predicted body (not
    what it carries); hidden legs (and hidden shins under seen thighs) are placed with
-   their feet on the floor;
+   their feet on the floor; once seen from the front a few times, its neck height and
+   shoulder width are measured and its model resized;
 5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
    walks (the speed of its last estimates in full view, while recent, or its blob's then)
    and is not at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
@@ -298,11 +299,12 @@ class _Person:
         """With Method.shape: measure the neck depth and shoulder breadth
         (occupose.body.size.neck_and_shoulders) in the first of ``observation``'s views
         that sees this estimate from the front or the back (SHAPE_FRONTAL, SHAPE_LEVEL;
-        trunk, head and arms in view, upright); with SHAPE_FRAMES measurements, go on with a model
-        of their medians (occupose.body.size.dims_with_shoulders; the particles moved so
-        that the estimate keeps its joints)."""
-        upper = [self.model.part_names.index(p) for p in self.model.part_names if not p.endswith(("thigh", "shin"))]
-        if self.shaped or not self.part_visible[upper].all() or abs(self.pose[self.model.dof("trunk_lean")]) > SHAPE_LEAN:
+        trunk, head and arms in view, upright); with SHAPE_FRAMES measurements, go on with
+        a model of their medians (occupose.body.size.dims_with_shoulders; the particles
+        moved so that the estimate keeps its joints)."""
+        legs = np.array([name.endswith(("thigh", "shin")) for name in self.model.part_names])
+        upright = abs(self.pose[self.model.dof("trunk_lean")]) <= SHAPE_LEAN
+        if self.shaped or not (self.part_visible | legs).all() or not upright:
             return
         heading = self.pose[self.problem.heading_dof]
         for view in observation.views:
