@@ -426,7 +426,7 @@ def test_neck_and_shoulders_of_rendered_walkers():
     one with the mocap subject's shape (a neck 5 cm lower, shoulders 0.6 as wide)."""
     average = D.scaled(1.75)
     subject = replace(average, spine=0.78 * average.spine, shoulder_width=0.6 * average.shoulder_width,
-                           neck_head=average.neck_head + 0.11 * average.spine)
+                      neck_head=average.neck_head + 0.11 * average.spine)
     widths = []
     for dims in (average, subject):
         profiles = _walker_profiles(dims)
