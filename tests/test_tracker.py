@@ -27,6 +27,8 @@ from occupose.tracker import (
     LATER_SPEED,
     METHODS,
     SHAPE_FRAMES,
+    STATURE_CHANGE,
+    STATURE_FRAMES,
     START_CHECK_S,
     WALK_FRAMES,
     WALK_FROM,
@@ -106,6 +108,32 @@ def test_a_person_seen_from_the_front_is_resized_once_to_its_neck_and_shoulders(
     track_frames(unshaped, rendered, len(rendered))
     kept = unshaped.people[1].model.dims  # the average adult's proportions at the measured stature
     assert not unshaped.people[1].shapes and kept == sm.DEFAULT_DIMS.scaled(kept.height)
+
+
+def test_a_person_picked_up_slowly_from_the_ceiling_gets_its_stature_measured_again():
+    """Under a ceiling camera the grid picks a person up over its first frames, and the
+    start's points do not reach the head yet: the stature is measured again on the first
+    STATURE_FRAMES upright estimates and the model rescaled."""
+    scenario = build_scenario("top_view_arms", use_mocap=False)
+    rendered = list(frames(scenario, seed=0, num_frames=40))
+    starts = []
+    tracker = Tracker(scenario.cameras, scenario.fps, "part-based", seed=0)
+    original = tracker._start
+
+    def start(*args):
+        person = original(*args)
+        if person is not None:
+            starts.append(person.model.dims.height)
+        return person
+
+    tracker._start = start
+    track_frames(tracker, rendered, len(rendered))
+    person = tracker.people[1]
+    truth = sm.dims_from_joints(scenario.people[0].joints).height
+    assert starts[0] < truth - 0.2  # measured 1.448 m for 1.749
+    assert len(person.tops) == STATURE_FRAMES
+    assert person.model.dims.height == pytest.approx(np.median(person.tops))
+    assert person.model.dims.height == pytest.approx(truth, abs=STATURE_CHANGE)  # measured 1.727
 
 
 def test_track_frames_takes_the_first_num_frames_of_longer_input(walk):

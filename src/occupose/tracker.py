@@ -22,8 +22,9 @@ A frame:
    occlusion check (its previous estimate moved to the blob's new centre of mass), then
    the filter on the visible subtree, given only its points near that predicted body (not
    what it carries); hidden legs (and hidden shins under seen thighs) are placed with
-   their feet on the floor; once seen from the front a few times, its neck height and
-   shoulder width are measured and its model resized;
+   their feet on the floor; its stature is measured again over its first second upright,
+   and once seen from the front a few times its neck height and shoulder width, and its
+   model resized;
 5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
    walks (the speed of its last estimates in full view, while recent, or its blob's then)
    and is not at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
@@ -55,7 +56,7 @@ from occupose.body import (
     joints_from_poses,
     pose_from_joints,
 )
-from occupose.body.size import TOP_RANK, breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
+from occupose.body.size import TOP_BIAS, TOP_RANK, breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
 from occupose.camera import Camera, points_from_depth
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
@@ -183,6 +184,15 @@ SHAPE_FRAMES = 6
 SHAPE_LEAN = 0.3
 SHAPE_LEVEL = np.deg2rad(35.0)
 SHAPE_FRONTAL = np.deg2rad(37.0)
+#: A person's stature is measured again on its first STATURE_FRAMES estimates with the
+#: pelvis upright (at least STATURE_UPRIGHT of the legs' length above the floor), and its
+#: model rescaled when their median differs from the start's by more than STATURE_CHANGE
+#: metres: a ceiling camera's grid picks a person up over its first frames, and the start's
+#: points may not reach the head yet (top_view_arms_flashy: 1.29 m, the shoulders, for a
+#: head's top near 1.55; from the front the start's stature was within 2-3 cm).
+STATURE_FRAMES = 30
+STATURE_UPRIGHT = 0.8
+STATURE_CHANGE = 0.05
 #: The upper-body model sees only the points above this share of the person's stature
 #: (the hips are at about 0.53).
 UPPER_CUT = 0.5
@@ -258,6 +268,7 @@ class _Person:
         self.estimates = 0  # estimates since the start (settle)
         self.shapes: list[tuple[float, float]] = []  # (neck depth, shoulder breadth) metres (learn_shape)
         self.shaped = not (method.shape and model.name == "full")  # resized, or never to be
+        self.tops: list[float] = []  # statures measured on its first estimates (learn_stature)
 
     def settle(self, pose: np.ndarray, velocity: np.ndarray) -> None:
         """Take a new estimate (D,); velocity (2,) m/s: its blob's horizontal velocity."""
@@ -312,7 +323,7 @@ class _Person:
             square = abs(np.cos(heading) * ray[0] + np.sin(heading) * ray[1]) / max(float(np.hypot(*ray)), 1e-9)
             if view.camera.down_angle > SHAPE_LEVEL or square < np.cos(SHAPE_FRONTAL):
                 continue
-            points = points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0]
+            points = _view_points(view)
             measured = neck_and_shoulders(breadth_profile(points)) if len(points) >= TOP_RANK else None
             if measured is not None:
                 self.shapes.append(measured)
@@ -320,13 +331,35 @@ class _Person:
         if len(self.shapes) < SHAPE_FRAMES:
             return
         depth, breadth = np.median(self.shapes, axis=0)
-        model = body_model(self.model.name, dims_with_shoulders(self.model.dims, self.model.girth, depth, breadth),
-                           self.model.girth)
+        self._resize(dims_with_shoulders(self.model.dims, self.model.girth, depth, breadth))
+        self.shaped = True
+
+    def learn_stature(self, observation: Observation) -> None:
+        """Measure the stature again (the top of the person's points, as at the start) on
+        its first STATURE_FRAMES estimates with the pelvis upright (at least
+        STATURE_UPRIGHT of the legs' length above the floor); when their median differs
+        from the model's by more than STATURE_CHANGE, go on with the model scaled to it
+        (its proportions kept; the particles moved so that the estimate keeps its joints)."""
+        dims = self.model.dims
+        legs = dims.ankle_height + dims.shin + dims.thigh
+        if len(self.tops) >= STATURE_FRAMES or self.pose[self.model.dof("z")] < STATURE_UPRIGHT * legs:
+            return
+        points = np.concatenate([_view_points(view) for view in observation.views])
+        if len(points) < TOP_RANK:
+            return
+        self.tops.append(top_height(points[:, 2]) + TOP_BIAS)
+        if len(self.tops) == STATURE_FRAMES and abs(np.median(self.tops) - dims.height) > STATURE_CHANGE:
+            self._resize(dims.scaled(float(np.clip(np.median(self.tops), 1.0, 2.2))))
+
+    def _resize(self, dims) -> None:
+        """Go on with a model of ``dims`` (girth kept), the particles moved so that the
+        estimate keeps its joints."""
+        model = body_model(self.model.name, dims, self.model.girth)
         pose = pose_from_joints(model, joints_of(self.model, self.pose), refine=False)
         self.model = model
         self.problem.resize(model)
         self.estimator.shift(pose - self.pose)
-        self.pose, self.shaped = pose, True
+        self.pose = pose
 
     def walking(self) -> tuple[float, float] | None:
         """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
@@ -422,6 +455,11 @@ class _Person:
             return point_distances(a, b, radii, points, sort=False)[0][0].astype(np.float64)
 
         return distance
+
+
+def _view_points(view: View) -> np.ndarray:
+    """(N, 3) world metres: the measured pixels of a view's mask, back-projected."""
+    return points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0]
 
 
 def joints_of(model: BodyModel, pose: np.ndarray) -> np.ndarray:
@@ -745,6 +783,7 @@ class Tracker:
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
         person.settle(pose, self.blobs.states[tid].velocity)
         person.face_the_way_walked()
+        person.learn_stature(seen)
         person.learn_shape(seen)
         return person.estimate(True)
 
