@@ -22,9 +22,9 @@ A frame:
    occlusion check (its previous estimate moved to the blob's new centre of mass), then
    the filter on the visible subtree, given only its points near that predicted body (not
    what it carries); hidden legs (and hidden shins under seen thighs) are placed with
-   their feet on the floor; its stature is measured again over its first second upright,
-   and once seen from the front a few times its neck height and shoulder width, and its
-   model resized;
+   their feet on the floor; its stature is measured again over its first second upright
+   and, once it has been seen from the front a few times, its neck height and shoulder
+   width; its model is resized to them;
 5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
    walks (the speed of its last estimates in full view, while recent, or its blob's then)
    and is not at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
@@ -56,7 +56,14 @@ from occupose.body import (
     joints_from_poses,
     pose_from_joints,
 )
-from occupose.body.size import TOP_BIAS, TOP_RANK, breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
+from occupose.body.size import (
+    TOP_BIAS,
+    TOP_RANK,
+    breadth_profile,
+    dims_with_shoulders,
+    neck_and_shoulders,
+    top_height,
+)
 from occupose.camera import Camera, points_from_depth
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
@@ -352,8 +359,8 @@ class _Person:
             self._resize(dims.scaled(float(np.clip(np.median(self.tops), 1.0, 2.2))))
 
     def _resize(self, dims) -> None:
-        """Go on with a model of ``dims`` (girth kept), the particles moved so that the
-        estimate keeps its joints."""
+        """Go on with a model of ``dims`` (BodyDims; girth kept), the particles moved so
+        that the estimate keeps its joints."""
         model = body_model(self.model.name, dims, self.model.girth)
         pose = pose_from_joints(model, joints_of(self.model, self.pose), refine=False)
         self.model = model
