@@ -64,14 +64,14 @@ from occupose.body.size import (
     neck_and_shoulders,
     top_height,
 )
-from occupose.camera import Camera, points_from_depth
+from occupose.camera import Camera
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.observation import observations_from_depth, predicted_from_tracks
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.tracking import BlobTracker
 from occupose.joints import NUM_JOINTS
-from occupose.likelihood import Observation, View, observation_from_views, point_distances
+from occupose.likelihood import Observation, View, observation_from_views, point_distances, view_points
 from occupose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.pose import PoseEstimator, PoseProblem
 from occupose.proposals import feet, unexplained_points
@@ -320,9 +320,10 @@ class _Person:
         trunk, head and arms in view, upright); with SHAPE_FRAMES measurements, go on with
         a model of their medians (occupose.body.size.dims_with_shoulders; the particles
         moved so that the estimate keeps its joints)."""
+        if self.shaped or abs(self.pose[self.model.dof("trunk_lean")]) > SHAPE_LEAN:
+            return
         legs = np.array([name.endswith(("thigh", "shin")) for name in self.model.part_names])
-        upright = abs(self.pose[self.model.dof("trunk_lean")]) <= SHAPE_LEAN
-        if self.shaped or not (self.part_visible | legs).all() or not upright:
+        if not (self.part_visible | legs).all():
             return
         heading = self.pose[self.problem.heading_dof]
         for view in observation.views:
@@ -330,7 +331,7 @@ class _Person:
             square = abs(np.cos(heading) * ray[0] + np.sin(heading) * ray[1]) / max(float(np.hypot(*ray)), 1e-9)
             if view.camera.down_angle > SHAPE_LEVEL or square < np.cos(SHAPE_FRONTAL):
                 continue
-            points = _view_points(view)
+            points = view_points(view)
             measured = neck_and_shoulders(breadth_profile(points)) if len(points) >= TOP_RANK else None
             if measured is not None:
                 self.shapes.append(measured)
@@ -351,7 +352,7 @@ class _Person:
         legs = dims.ankle_height + dims.shin + dims.thigh
         if len(self.tops) >= STATURE_FRAMES or self.pose[self.model.dof("z")] < STATURE_UPRIGHT * legs:
             return
-        points = np.concatenate([_view_points(view) for view in observation.views])
+        points = np.concatenate([view_points(view) for view in observation.views])
         if len(points) < TOP_RANK:
             return
         self.tops.append(top_height(points[:, 2]) + TOP_BIAS)
@@ -462,11 +463,6 @@ class _Person:
             return point_distances(a, b, radii, points, sort=False)[0][0].astype(np.float64)
 
         return distance
-
-
-def _view_points(view: View) -> np.ndarray:
-    """(N, 3) world metres: the measured pixels of a view's mask, back-projected."""
-    return points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0]
 
 
 def joints_of(model: BodyModel, pose: np.ndarray) -> np.ndarray:

@@ -84,12 +84,16 @@ class BodySize(NamedTuple):
     girth: float
 
 
-def _breadth(xy: np.ndarray) -> float:
-    """Extent (metres) of horizontal points (N, 2) along their principal axis, between quantiles."""
+def _along(xy: np.ndarray) -> np.ndarray:
+    """(N,) metres: horizontal points (N, 2) along their principal axis (from their mean)."""
     centred = xy - xy.mean(axis=0)
     _, vectors = np.linalg.eigh(centred.T @ centred)
-    along = centred @ vectors[:, -1]
-    lo, hi = np.quantile(along, BREADTH_QUANTILES)
+    return centred @ vectors[:, -1]
+
+
+def _breadth(xy: np.ndarray) -> float:
+    """Extent (metres) of horizontal points (N, 2) along their principal axis, between quantiles."""
+    lo, hi = np.quantile(_along(xy), BREADTH_QUANTILES)
     return float(hi - lo)
 
 
@@ -164,9 +168,7 @@ def breadth_profile(points) -> np.ndarray:
     depth = top_height(points[:, 2]) - points[:, 2]
     upper = (depth >= 0.0) & (depth < count * PROFILE_SLICE)
     depth = depth[upper]
-    centred = points[upper, :2] - points[upper, :2].mean(axis=0)
-    _, vectors = np.linalg.eigh(centred.T @ centred)
-    along = centred @ vectors[:, -1]
+    along = _along(points[upper, :2])
     slices = np.minimum((depth / PROFILE_SLICE).astype(np.int64), count - 1)
     profile = np.full(count, np.nan)
     for k in np.flatnonzero(np.bincount(slices, minlength=count) >= MIN_PROFILE_POINTS):

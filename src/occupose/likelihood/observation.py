@@ -125,6 +125,12 @@ class Observation:
         return blocked_points(self.points)
 
 
+def view_points(view: View) -> np.ndarray:
+    """(N, 3) world metres: the measured pixels (depth > 0) of a view's mask, back-projected,
+    row-major."""
+    return points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0]
+
+
 def observation_from_views(views, max_points: int = 2000) -> Observation:
     """The Observation whose points are the person's pixels of every view, back-projected.
 
@@ -140,7 +146,7 @@ def observation_from_views(views, max_points: int = 2000) -> Observation:
     for view in views:
         if not isinstance(view, View):
             raise ValueError(f"views must be a sequence of View, got a {type(view).__name__}")
-        chunks.append(points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0])
+        chunks.append(view_points(view))
     points = np.concatenate(chunks)
     if len(points) > max_points:
         points = points[np.linspace(0, len(points) - 1, max_points).round().astype(np.int64)]
