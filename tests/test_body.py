@@ -12,6 +12,7 @@ from scipy import stats
 from occupose.body import (BODY_MODELS, limb_angles, body_model, capsules_from_poses, diffuse, diffusion_scales,
                            dims_from_observation, joints_from_poses, pose_from_joints, root_drift,
                            standing_pose)
+from occupose.body.model import FULL_TORSO_SPREAD
 from occupose.body.size import breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
 from occupose.camera import points_from_depth
 from occupose.joints import JOINT_INDEX as J
@@ -68,7 +69,7 @@ def _random_poses(model, rng, count):
 # Model tables
 
 
-@pytest.mark.parametrize("name, dofs, parts, capsules", [("full", 25, 10, 10), ("upper", 17, 5, 13)])
+@pytest.mark.parametrize("name, dofs, parts, capsules", [("full", 25, 10, 11), ("upper", 17, 5, 13)])
 def test_model_tables(name, dofs, parts, capsules):
     m = BODY_MODELS[name]
     assert (m.num_dofs, m.num_parts, m.num_capsules) == (dofs, parts, capsules)
@@ -112,7 +113,7 @@ def test_body_model_registry_errors_and_sizes():
         body_model("full", girth=3.0)
     tall = body_model("full", D.scaled(1.9), girth=1.2)
     assert tall.offsets[tall.node_names.index("left_knee"), 2] == pytest.approx(-D.thigh * 1.9 / D.height)
-    limbs = np.arange(tall.num_capsules) != tall.part_names.index("head")  # the head follows stature
+    limbs = tall.capsule_part != tall.part_names.index("head")  # the head follows stature
     assert np.allclose(tall.capsule_radii[limbs], BODY_MODELS["full"].capsule_radii[limbs] * 1.2)
 
 
@@ -176,9 +177,10 @@ def test_zero_pose_stands_upright():
     np.testing.assert_allclose(j[J["left_wrist"]], [1.0, 2.0 + D.shoulder_width, sh_z - D.upper_arm - D.forearm])
     np.testing.assert_allclose(j[J["right_ankle"]], [1.0, 2.0 - D.pelvis_width / 2, 0.9 - D.thigh - D.shin])
     a, b = capsules_from_poses(m, _pose(m, z=0.9)[None])
-    torso = m.part_names.index("torso")
-    np.testing.assert_allclose(a[0, torso], [0, 0, 0.9 + 0.12 * D.spine])
-    np.testing.assert_allclose(b[0, torso], [0, 0, 0.9 + 0.79 * D.spine])
+    torso = m.capsule_part == m.part_names.index("torso")  # two cones, left and right
+    hips, chest = FULL_TORSO_SPREAD
+    np.testing.assert_allclose(a[0, torso], [[0, hips, 0.9 + 0.12 * D.spine], [0, -hips, 0.9 + 0.12 * D.spine]])
+    np.testing.assert_allclose(b[0, torso], [[0, chest, 0.9 + 0.79 * D.spine], [0, -chest, 0.9 + 0.79 * D.spine]])
 
 
 def test_arm_raised_forward_and_turned():

@@ -183,7 +183,8 @@ def test_a_hip_higher_than_its_leg_reaches_costs_even_with_the_legs_hidden(walk)
     torso = model.part_names.index("torso")
     a, _ = capsules_from_poses(model, lifted[None])
     thighs = [c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("thigh")]
-    reach = model.dims.thigh + model.dims.shin + model.capsule_radii[model.part_names.index("left_shin"), 1]
+    shin = np.flatnonzero(model.capsule_part == model.part_names.index("left_shin"))[0]
+    reach = model.dims.thigh + model.dims.shin + model.capsule_radii[shin, 1]
     expected = REACH_COST * (a[0, thighs, 2].min() - reach - REACH_SLACK)
     assert expected > 0.05 * REACH_COST
     for hidden in (False, True):

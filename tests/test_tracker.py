@@ -149,15 +149,22 @@ def test_track_frames_takes_the_first_num_frames_of_longer_input(walk):
 
 
 def test_overlapping_the_grid_with_the_pose_stage_tracks_alike(walk):
-    """The grid update of frame t + 1 runs during stage 3 of frame t (its hold mask from the
-    bodies of frame t - 1): the same person, tracked as well."""
+    """The grid update of frame t + 1 runs during stage 3 of frame t. Without hold masks the
+    grid does not depend on the poses, and the tracks are the same to the bit; with them
+    (frame t + 1's from the bodies of frame t - 1) the run differs and tracks the person as
+    well: the same person, under 8 cm (the two runs part like two seeds do: by 0.4-6 cm on
+    these 40 frames, either way)."""
     scenario, rendered = walk
-    results = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0), rendered[:40], 40, overlap=o)
-               for o in (False, True)]
-    assert [list(r.tracks) for r in results] == [[1], [1]]
     gt = np.stack([f.joints[0] for f in rendered[:40]])
-    errors = [np.nanmean(frame_errors(joint_errors(gt, r.tracks[1][0]))) for r in results]
-    assert abs(errors[0] - errors[1]) < 0.01, errors
+    for hold in (False, True):
+        results = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0, hold_people=hold),
+                                rendered[:40], 40, overlap=o) for o in (False, True)]
+        assert [list(r.tracks) for r in results] == [[1], [1]]
+        errors = [np.nanmean(frame_errors(joint_errors(gt, r.tracks[1][0]))) for r in results]
+        if hold:
+            assert max(errors) < 0.08, errors
+        else:
+            assert np.array_equal(results[0].tracks[1][0], results[1].tracks[1][0], equal_nan=True)
 
 
 def test_same_seed_same_tracks(walk):

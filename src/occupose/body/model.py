@@ -25,12 +25,12 @@ Two built-in models (:data:`BODY_MODELS`, :func:`body_model`):
     - [17] ``left_hip_flex, _abd, _rot, left_knee``: the thigh forward, out to the side,
       turned outwards; knee flexion (0 = straight, the shin swings back); [21] right leg.
 
-    Parts (one round cone each): torso, head, left_upper_arm, left_forearm (the hand
-    included as a short extension past the wrist), right_upper_arm, right_forearm,
-    left_thigh, left_shin, right_thigh, right_shin. Partitions: the root with the torso's
-    orientation (weighted by the torso and the upper arms and thighs, whose attachment
-    shows the heading that a round torso cannot), the head, the left arm, the right arm,
-    the left leg, the right leg.
+    Parts (one round cone each, the torso two side by side): torso, head, left_upper_arm,
+    left_forearm (the hand included as a short extension past the wrist), right_upper_arm,
+    right_forearm, left_thigh, left_shin, right_thigh, right_shin. Partitions: the root
+    with the torso's orientation (weighted by the torso and the upper arms and thighs,
+    whose attachment shows the heading too), the head, the left arm, the right arm, the
+    left leg, the right leg.
 
 ``upper`` -- the second paper's 6-part, 17-DOF upper body (top view):
     x, y, z (pelvis), heading, trunk_lean (the bend at the pelvis), neck_flex, neck_side,
@@ -47,12 +47,16 @@ Angle conventions equal :mod:`occupose.synth.motion` (same names), so a procedur
 arm and leg angles carry over; the model's hips turn with the torso where the generator's
 stay level, so hip flexion here = the generator's hip flexion + trunk lean.
 
-Deviations from the papers, and why: the upper model's second neck DOF is the sideways
-tilt, not the turn about the head's axis, because a round-cone head does not change when
-turned about its axis (the full model keeps the first paper's 3 head DOFs; its neck_twist
-is unobservable for the same reason and gets a small diffusion). Each limb is one
-partition (shoulder + elbow, hip + knee) because the upper segment's roll about its own
-axis is seen only through the bent lower segment.
+Deviations from the papers, and why: the full model's torso is not one cylinder but two
+cones side by side, a flat section like the upper model's (and a person's): a round torso
+looks the same turned any way, so a standing person's heading rested on the shoulders and
+hips alone and drifted by 30-60 degrees while they gestured with their legs hidden behind
+a chair. The upper model's second neck DOF is the sideways tilt, not the turn about the
+head's axis, because a round-cone head does not change when turned about its axis (the
+full model keeps the first paper's 3 head DOFs; its neck_twist is unobservable for the
+same reason and gets a small diffusion). Each limb is one partition (shoulder + elbow,
+hip + knee) because the upper segment's roll about its own axis is seen only through the
+bent lower segment.
 """
 
 from __future__ import annotations
@@ -286,17 +290,23 @@ _FOREARM_TWIST = (-1.6, 1.6)
 # ---------------------------------------------------------------------------------------
 # Shapes: radii of an average adult at girth 1 (metres), from mean circumferences of the
 # ANSUR II survey rounded to the nearest 5 mm and adjusted to cover the renderer's bodies:
-# chest 0.15, waist/hips 0.14, upper arm 0.05 -> 0.04, forearm 0.04 -> 0.03, thigh
-# 0.08 -> 0.055, calf 0.05 -> 0.04. The head is sized from the neck -> head-centre length
-# (0.11 m at the default), not the girth.
+# the torso's two cones (FULL_TORSO_SPREAD) 0.12 at the hips -> 0.118 at the chest, upper
+# arm 0.05 -> 0.04, forearm 0.04 -> 0.03, thigh 0.08 -> 0.055, calf 0.05 -> 0.04. The head
+# is sized from the neck -> head-centre length (0.11 m at the default), not the girth.
 
-FULL_RADII = {"torso": (0.14, 0.15), "head": (0.055, 0.085), "upper_arm": (0.05, 0.04),
+FULL_RADII = {"torso": (0.12, 0.118), "head": (0.055, 0.085), "upper_arm": (0.05, 0.04),
               "forearm": (0.04, 0.035), "thigh": (0.08, 0.055), "shin": (0.05, 0.04)}
 UPPER_RADII = {"head": (0.055, 0.085), "shoulders": (0.06, 0.06), "torso": (0.10, 0.10),
                "upper_arm": (0.05, 0.04), "forearm": (0.04, 0.03), "hand": (0.02, 0.018)}
 #: Lateral offset of the upper model's side torso cones at girth 1, metres: with radius
 #: 0.10 the 3 cones span an elliptic section of half-width 0.165 and half-depth 0.10.
 UPPER_TORSO_SPREAD = 0.065
+#: Lateral offsets of the full model's two torso cones at girth 1, metres, at the hips and
+#: at the chest: with their radii they span a section of half-width 0.15 and half-depth 0.12
+#: at the hips and 0.173 x 0.118 at the chest (the renderer's chest: 0.165 x 0.110). Hips
+#: as wide as the chest (a flat section all the way) tracked a walk seen side on worse:
+#: the legs swapped more often.
+FULL_TORSO_SPREAD = (0.03, 0.055)
 #: Hand of the upper model: half the palm width (the offset of its two thin cones across
 #: the palm) and the start and end of the cones past the wrist, metres at default size.
 HAND_HALF_WIDTH, HAND_START, HAND_END = 0.022, 0.015, 0.15
@@ -345,8 +355,12 @@ def full_model(dims: BodyDims = DEFAULT_DIMS, girth: float = 1.0) -> BodyModel:
         b.node(f"{side}_ankle", f"{side}_knee", (0, 0, -d.shin), joint=f"{side}_ankle")
 
     r = {k: (v[0] * g, v[1] * g) for k, v in FULL_RADII.items()}
-    # torso: bottom cap ~7 cm below the hip joints, top cap ~3 cm above the neck joint
-    b.capsule("torso", "pelvis", (0, 0, 0.12 * d.spine), "pelvis", (0, 0, 0.79 * d.spine), *r["torso"])
+    # torso: two cones side by side (a flat section, which shows the heading), closer at the
+    # hips; bottom caps ~7 cm below the hip joints, top caps ~3 cm above the neck joint
+    hips, chest = FULL_TORSO_SPREAD
+    for s in (g, -g):
+        b.capsule("torso", "pelvis", (0, s * hips, 0.12 * d.spine), "pelvis", (0, s * chest, 0.79 * d.spine),
+                  *r["torso"])
     _head(b, d, FULL_RADII)
     hand = FULL_HAND_EXTENSION * d.forearm / DEFAULT_DIMS.forearm
     for side in ("left", "right"):
@@ -369,8 +383,8 @@ def full_model(dims: BodyDims = DEFAULT_DIMS, girth: float = 1.0) -> BodyModel:
              ("right_shoulder", "right_elbow", ["right_upper_arm", "right_forearm"]),
              ("left_hip", "left_knee", ["left_thigh", "left_shin"]),
              ("right_hip", "right_knee", ["right_thigh", "right_shin"])]
-    # The round-cone torso does not see its own heading: the shoulders and hips it carries
-    # do, so the upper arms and thighs weight the torso partition too.
+    # The shoulders and hips the torso carries show its heading too (and the torso alone
+    # little of it when seen side on), so the upper arms and thighs weight its partition.
     partitions = [(root, ["torso", "left_upper_arm", "right_upper_arm", "left_thigh", "right_thigh"]),
                   (block("neck_"), ["head"])]
     partitions += [(block(upper) + block(lower), list(limb_parts)) for upper, lower, limb_parts in limbs]
