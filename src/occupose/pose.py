@@ -49,7 +49,8 @@ class PoseProblem:
         key of :data:`PART_WEIGHTS` (see :func:`chain_weight_groups`)
     floor : height of the floor, world metres (DESIGN: z = 0), below which a part costs
         :data:`FLOOR_COST` nats per metre, and above which a hip cannot be higher than its
-        leg reaches (:func:`add_reach_term`); None for no floor
+        leg reaches, nor a head without legs higher than the stature once it is known
+        (:func:`add_reach_term`, :attr:`stature_known`); None for no floor
     """
 
     def __init__(self, model: BodyModel, likelihood: str = "points+free", *, fps: float = 30.0,
@@ -85,6 +86,11 @@ class PoseProblem:
         #: Whether the person stands (feet on the floor: their points say where the legs
         #: go, see :func:`occupose.proposals.feet`); set per frame by the tracker.
         self.standing = False
+        #: Whether ``model.dims.height`` is the person's stature measured well: only then
+        #: does a model without legs cost a head above it (the reach term). True by default;
+        #: the tracker clears it until it has measured the stature again over the person's
+        #: first second upright (the start's may fall short of the head under a ceiling camera).
+        self.stature_known = True
         #: The index of the model's heading DOF, or None for a model without one.
         self.heading_dof = model.dof_names.index("heading") if "heading" in model.dof_names else None
         self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self.heading_dof in g.dofs), None)
@@ -113,7 +119,7 @@ class PoseProblem:
                                         len(self.model.part_names))
         if self.floor is not None:
             add_floor_term(self.model, a, b, self.floor, out)
-            add_reach_term(self.model, a, self.floor, out)
+            add_reach_term(self.model, a, b, self.floor, out, head=self.stature_known)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
@@ -131,31 +137,40 @@ def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float,
         np.add.at(out.T, model.capsule_part, -FLOOR_COST * sunk.T)
 
 
-def add_reach_term(model: BodyModel, a: np.ndarray, floor: float, out: np.ndarray) -> None:
-    """Add the reach term to per-part log-likelihoods ``out`` (P, K), in place: where the
-    lower hip (the thighs' top ends, from capsule ends a (P, C, 3) world metres) is higher
-    above ``floor`` than a straight leg reaches (thigh + shin + the shin's bottom radius)
-    plus REACH_SLACK, the root's part costs REACH_COST nats per metre beyond. A model
-    without legs gets nothing."""
-    legs = _leg_reach(model)
-    if legs is None:
+def add_reach_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray, *,
+                   head: bool = True) -> None:
+    """Add the reach term to per-part log-likelihoods ``out`` (P, K), in place, from the
+    capsule ends a, b (P, C, 3), world metres: the root's part costs REACH_COST nats per
+    metre that the body reaches higher above ``floor`` than it can standing, plus
+    REACH_SLACK. With legs that is the lower hip (the thighs' top ends) above a straight
+    leg's reach (thigh + shin + the shin's bottom radius); without legs (the upper body,
+    seen from above) the head's top above the stature (``model.dims.height``), when
+    ``head`` (else nothing)."""
+    thighs, heads, reach, root_part = _reach(model)
+    if not len(thighs) and not head:
         return
-    thighs, reach, root_part = legs
-    over = np.maximum(a[:, thighs, 2].min(axis=1) - floor - reach - REACH_SLACK, 0.0)
-    out[:, root_part] -= REACH_COST * over
+    if len(thighs):
+        top = a[:, thighs, 2].min(axis=1)
+    else:
+        radii = model.capsule_radii[heads]
+        top = np.maximum(a[:, heads, 2] + radii[:, 0], b[:, heads, 2] + radii[:, 1]).max(axis=1)
+    out[:, root_part] -= REACH_COST * np.maximum(top - floor - reach - REACH_SLACK, 0.0)
 
 
 @functools.lru_cache(maxsize=64)
-def _leg_reach(model: BodyModel) -> tuple[np.ndarray, float, int] | None:
-    """(the thighs' capsules, a straight leg's reach in metres, the root's part) of
-    ``model``, or None without legs (cached: the likelihood is evaluated many times a frame)."""
+def _reach(model: BodyModel) -> tuple[np.ndarray, np.ndarray, float, int]:
+    """(the thighs' capsules, the head's capsules, how high they reach standing in metres,
+    the root's part) of ``model`` (cached: the likelihood is evaluated many times a frame).
+    Without legs, the reach is the head's top: the stature."""
     part = [model.part_names[k] for k in model.capsule_part]
-    thighs = np.array([c for c, name in enumerate(part) if name.endswith("thigh")])
+    thighs = np.array([c for c, name in enumerate(part) if name.endswith("thigh")], np.int64)
+    head = np.array([c for c, name in enumerate(part) if name == "head"], np.int64)
     shin = next((c for c, name in enumerate(part) if name.endswith("shin")), None)
-    if not len(thighs) or shin is None:
-        return None
-    reach = model.dims.thigh + model.dims.shin + float(model.capsule_radii[shin, 1])
-    return thighs, reach, int(model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]])
+    if len(thighs) and shin is not None:
+        reach = model.dims.thigh + model.dims.shin + float(model.capsule_radii[shin, 1])
+    else:
+        thighs, reach = thighs[:0], model.dims.height
+    return thighs, head, reach, int(model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]])
 
 
 def _moved_parts(model: BodyModel, dofs: np.ndarray) -> np.ndarray:

@@ -276,6 +276,7 @@ class _Person:
         self.shapes: list[tuple[float, float]] = []  # (neck depth, shoulder breadth) metres (learn_shape)
         self.shaped = not (method.shape and model.name == "full")  # resized, or never to be
         self.tops: list[float] = []  # statures measured on its first estimates (learn_stature)
+        self.problem.stature_known = False  # until learn_stature has measured it again
 
     def settle(self, pose: np.ndarray, velocity: np.ndarray) -> None:
         """Take a new estimate (D,); velocity (2,) m/s: its blob's horizontal velocity."""
@@ -347,7 +348,9 @@ class _Person:
         its first STATURE_FRAMES estimates with the pelvis upright (at least
         STATURE_UPRIGHT of the legs' length above the floor); when their median differs
         from the model's by more than STATURE_CHANGE, go on with the model scaled to it
-        (its proportions kept; the particles moved so that the estimate keeps its joints)."""
+        (its proportions kept; the particles moved so that the estimate keeps its joints).
+        Then the stature is known (PoseProblem.stature_known: the upper body's head may
+        not rise above it)."""
         dims = self.model.dims
         legs = dims.ankle_height + dims.shin + dims.thigh
         if len(self.tops) >= STATURE_FRAMES or self.pose[self.model.dof("z")] < STATURE_UPRIGHT * legs:
@@ -356,8 +359,10 @@ class _Person:
         if len(points) < TOP_RANK:
             return
         self.tops.append(top_height(points[:, 2]) + TOP_BIAS)
-        if len(self.tops) == STATURE_FRAMES and abs(np.median(self.tops) - dims.height) > STATURE_CHANGE:
-            self._resize(dims.scaled(float(np.clip(np.median(self.tops), 1.0, 2.2))))
+        if len(self.tops) == STATURE_FRAMES:
+            if abs(np.median(self.tops) - dims.height) > STATURE_CHANGE:
+                self._resize(dims.scaled(float(np.clip(np.median(self.tops), 1.0, 2.2))))
+            self.problem.stature_known = True
 
     def _resize(self, dims) -> None:
         """Go on with a model of ``dims`` (BodyDims; girth kept), the particles moved so
