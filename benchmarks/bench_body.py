@@ -1,7 +1,7 @@
 """Speed of the body models' forward kinematics and pose fitting.
 
 Cases: ``capsules_from_poses`` and ``joints_from_poses`` for 200 and 1000 particles of the
-``full`` (25 DOF, 10 cones) and ``upper`` (17 DOF, 13 cones) models, random poses within
+``full`` (25 DOF, 11 cones) and ``upper`` (17 DOF, 13 cones) models, random poses within
 the joint limits, on one numba thread and on all of them; ``pose_from_joints`` on frames of
 procedural motion (walking, waving, sitting). Medians over repeats (the cores may be shared).
 """

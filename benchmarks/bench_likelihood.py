@@ -2,7 +2,7 @@
 
 Scene: a person facing a Kinect v1 3 m away (640x480, noise-free render of occupose.synth),
 the observation their pixels (2000 points, person box about 240 x 460 pixels), particles
-the fitted true pose of the ``full`` model (10 round cones) diffused by 0.1 rad / 3 cm per
+the fitted true pose of the ``full`` model (11 round cones) diffused by 0.1 rad / 3 cm per
 DOF; the ``upper`` model (13 round cones) from a ceiling camera for the points term too.
 Throughput counts particle x evaluation pairs per second: observed points (points),
 surface samples (free: 27 per capsule, color: 32) or grid pixels (render: every 4th pixel

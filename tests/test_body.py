@@ -115,6 +115,9 @@ def test_body_model_registry_errors_and_sizes():
     assert tall.offsets[tall.node_names.index("left_knee"), 2] == pytest.approx(-D.thigh * 1.9 / D.height)
     limbs = tall.capsule_part != tall.part_names.index("head")  # the head follows stature
     assert np.allclose(tall.capsule_radii[limbs], BODY_MODELS["full"].capsule_radii[limbs] * 1.2)
+    torso = tall.capsule_part == tall.part_names.index("torso")  # its two cones: spaced by girth too
+    hips, chest = FULL_TORSO_SPREAD
+    assert np.allclose(tall.capsule_offsets[:, torso, 1], [[1.2 * hips, -1.2 * hips], [1.2 * chest, -1.2 * chest]])
 
 
 # ---------------------------------------------------------------------------------------

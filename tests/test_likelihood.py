@@ -409,16 +409,20 @@ def test_true_pose_scores_best_over_body_shapes():
 
 
 def test_full_torso_shows_the_heading(front):
-    """The full model's torso (two cones side by side) alone ranks the true heading first
-    among turns of up to 60 degrees either way: a standing person's heading no longer rests
-    on the shoulders and hips only (a round torso scored every turn the same)."""
+    """The full model's torso (two cones side by side) alone, on the torso's own points (those
+    nearest it in the true pose), ranks the true heading first among turns of up to 60
+    degrees either way: a standing person's heading no longer rests on the shoulders and
+    hips only (a round torso scored every turn the same)."""
     obs, pose = front
     poses = np.repeat(pose[None], 9, axis=0)
     poses[:, FULL.dof("heading")] += np.radians(np.linspace(-60.0, 60.0, 9))
     a, b, radii, part, num_parts = _model_capsules(FULL, poses)
     torso = part == FULL.part_names.index("torso")
     assert torso.sum() == 2
-    log_lik = PointsLikelihood(obs).evaluate(a[:, torso], b[:, torso], radii[torso], np.zeros(2, np.int64), 1)[:, 0]
+    _, nearest = point_distances(a[:1], b[:1], radii, obs.points)
+    own = Observation(obs.points[torso[nearest[0]]], obs.views)
+    assert len(own.points) > 300
+    log_lik = PointsLikelihood(own).evaluate(a[:, torso], b[:, torso], radii[torso], np.zeros(2, np.int64), 1)[:, 0]
     assert np.argmax(log_lik) == 4
     assert np.all(np.diff(log_lik[:5]) > 0) and np.all(np.diff(log_lik[4:]) < 0)
 

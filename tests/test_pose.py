@@ -200,20 +200,25 @@ def test_a_body_reaching_higher_than_it_can_standing_costs_even_with_the_legs_hi
     poses[1, upper.dof("z")] += 0.2
     out = np.zeros((2, len(upper.part_names)))
     add_reach_term(upper, *capsules_from_poses(upper, poses), 0.0, out)
-    root = upper.capsule_part[np.flatnonzero(upper.capsule_nodes[0] == 0)[0]]
+    root = upper.part_names.index("shoulders")  # the part of x, y, z
     a, b = capsules_from_poses(upper, poses[1:])
     top = np.maximum(a[0, :, 2] + upper.capsule_radii[:, 0], b[0, :, 2] + upper.capsule_radii[:, 1]).max()
     assert top == pytest.approx(upper.dims.height + 0.2, abs=0.01)  # the head's top, the body's highest
     np.testing.assert_allclose(out[:, root], [0.0, -REACH_COST * (top - upper.dims.height - REACH_SLACK)], atol=1e-9)
     assert not np.delete(out, root, axis=1).any()
     unknown = np.zeros_like(out)
-    add_reach_term(upper, *capsules_from_poses(upper, poses), 0.0, unknown, head=False)
+    add_reach_term(upper, *capsules_from_poses(upper, poses), 0.0, unknown, stature_known=False)
     assert not unknown.any()  # the stature not known yet: nothing
     problem = PoseProblem(upper)  # stature_known by default; the tracker clears it at first
     problem.set_observation(observations[10])
-    known = problem.log_likelihood(poses)
+    held = problem.log_likelihood(poses)
     problem.stature_known = False
-    np.testing.assert_allclose(known - problem.log_likelihood(poses), out, atol=1e-9)
+    np.testing.assert_allclose(held - problem.log_likelihood(poses), out, atol=1e-9)
+    # the full model's hips do not wait for the stature
+    hips_unknown, hips_known = np.zeros((2, 1, len(model.part_names)))
+    add_reach_term(model, *capsules_from_poses(model, lifted[None]), 0.0, hips_unknown, stature_known=False)
+    add_reach_term(model, *capsules_from_poses(model, lifted[None]), 0.0, hips_known)
+    assert np.array_equal(hips_unknown, hips_known) and hips_known[0, torso] == pytest.approx(-expected)
 
 
 def test_part_weights_chain_weighs_each_group_by_its_chain_to_the_root():

@@ -31,7 +31,11 @@ FLOOR_COST = 20.0
 #: Feet stand on the floor. A leg hidden behind furniture keeps its last configuration and
 #: rides along with the pelvis, so nothing else holds the body down: behind a couch or a
 #: chair the visible trunk, free to slide along its axis, rose 10-25 cm to fit a head
-#: larger than the model's (walk_behind_couch, gesture_behind_chair).
+#: larger than the model's (walk_behind_couch, gesture_behind_chair). A model without legs
+#: (the upper body, from the ceiling, where nothing seen beyond the body holds it down)
+#: costs as much per metre its head's top is above the stature plus REACH_SLACK, once the
+#: stature is known: the slack also covers a stature measured again within the tracker's
+#: STATURE_CHANGE (5 cm), which leaves the model as it is.
 REACH_SLACK = 0.05
 REACH_COST = 50.0
 
@@ -119,7 +123,7 @@ class PoseProblem:
                                         len(self.model.part_names))
         if self.floor is not None:
             add_floor_term(self.model, a, b, self.floor, out)
-            add_reach_term(self.model, a, b, self.floor, out, head=self.stature_known)
+            add_reach_term(self.model, a, b, self.floor, out, stature_known=self.stature_known)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
@@ -138,16 +142,16 @@ def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float,
 
 
 def add_reach_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray, *,
-                   head: bool = True) -> None:
+                   stature_known: bool = True) -> None:
     """Add the reach term to per-part log-likelihoods ``out`` (P, K), in place, from the
     capsule ends a, b (P, C, 3), world metres: the root's part costs REACH_COST nats per
     metre that the body reaches higher above ``floor`` than it can standing, plus
     REACH_SLACK. With legs that is the lower hip (the thighs' top ends) above a straight
     leg's reach (thigh + shin + the shin's bottom radius); without legs (the upper body,
     seen from above) the head's top above the stature (``model.dims.height``), when
-    ``head`` (else nothing)."""
+    ``stature_known`` (else, or without a head either, nothing)."""
     thighs, heads, reach, root_part = _reach(model)
-    if not len(thighs) and not head:
+    if not len(thighs) and not (stature_known and len(heads)):
         return
     if len(thighs):
         top = a[:, thighs, 2].min(axis=1)
@@ -164,13 +168,13 @@ def _reach(model: BodyModel) -> tuple[np.ndarray, np.ndarray, float, int]:
     Without legs, the reach is the head's top: the stature."""
     part = [model.part_names[k] for k in model.capsule_part]
     thighs = np.array([c for c, name in enumerate(part) if name.endswith("thigh")], np.int64)
-    head = np.array([c for c, name in enumerate(part) if name == "head"], np.int64)
+    heads = np.array([c for c, name in enumerate(part) if name == "head"], np.int64)
     shin = next((c for c, name in enumerate(part) if name.endswith("shin")), None)
     if len(thighs) and shin is not None:
         reach = model.dims.thigh + model.dims.shin + float(model.capsule_radii[shin, 1])
     else:
         thighs, reach = thighs[:0], model.dims.height
-    return thighs, head, reach, int(model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]])
+    return thighs, heads, reach, int(model.capsule_part[np.flatnonzero(model.capsule_nodes[0] == 0)[0]])
 
 
 def _moved_parts(model: BodyModel, dofs: np.ndarray) -> np.ndarray:

@@ -290,9 +290,10 @@ _FOREARM_TWIST = (-1.6, 1.6)
 # ---------------------------------------------------------------------------------------
 # Shapes: radii of an average adult at girth 1 (metres), from mean circumferences of the
 # ANSUR II survey rounded to the nearest 5 mm and adjusted to cover the renderer's bodies:
-# the torso's two cones (FULL_TORSO_SPREAD) 0.12 at the hips -> 0.118 at the chest, upper
-# arm 0.05 -> 0.04, forearm 0.04 -> 0.03, thigh 0.08 -> 0.055, calf 0.05 -> 0.04. The head
-# is sized from the neck -> head-centre length (0.11 m at the default), not the girth.
+# upper arm 0.05 -> 0.04, forearm 0.04 -> 0.035, thigh 0.08 -> 0.055, calf 0.05 -> 0.04;
+# the torso's two cones (FULL_TORSO_SPREAD), 0.12 at the hips -> 0.118 at the chest, were
+# chosen among three flat sections by tracking the catalogue's scenes. The head is sized
+# from the neck -> head-centre length (0.11 m at the default), not the girth.
 
 FULL_RADII = {"torso": (0.12, 0.118), "head": (0.055, 0.085), "upper_arm": (0.05, 0.04),
               "forearm": (0.04, 0.035), "thigh": (0.08, 0.055), "shin": (0.05, 0.04)}
@@ -332,7 +333,8 @@ def _check_size(dims: BodyDims, girth: float) -> None:
 
 def full_model(dims: BodyDims = DEFAULT_DIMS, girth: float = 1.0) -> BodyModel:
     """The 10-part, 25-DOF body of the first paper for a body of size ``dims`` (segment
-    lengths, metres) and ``girth`` (scale of the radii of torso and limbs, 1 = average adult)."""
+    lengths, metres) and ``girth`` (scale of the radii of torso and limbs and of the torso
+    cones' spacing, 1 = average adult)."""
     _check_size(dims, girth)
     g, d = float(girth), dims
     b = _Builder()
@@ -356,10 +358,10 @@ def full_model(dims: BodyDims = DEFAULT_DIMS, girth: float = 1.0) -> BodyModel:
 
     r = {k: (v[0] * g, v[1] * g) for k, v in FULL_RADII.items()}
     # torso: two cones side by side (a flat section, which shows the heading), closer at the
-    # hips; bottom caps ~7 cm below the hip joints, top caps ~3 cm above the neck joint
+    # hips; bottom caps ~5 cm below the hip joints, top caps at about the neck joint
     hips, chest = FULL_TORSO_SPREAD
-    for s in (g, -g):
-        b.capsule("torso", "pelvis", (0, s * hips, 0.12 * d.spine), "pelvis", (0, s * chest, 0.79 * d.spine),
+    for side in (g, -g):  # left, right (the spacing scales with the girth)
+        b.capsule("torso", "pelvis", (0, side * hips, 0.12 * d.spine), "pelvis", (0, side * chest, 0.79 * d.spine),
                   *r["torso"])
     _head(b, d, FULL_RADII)
     hand = FULL_HAND_EXTENSION * d.forearm / DEFAULT_DIMS.forearm

@@ -1,6 +1,6 @@
 """Synthetic human bodies posed from canonical joints.
 
-The rendered body is deliberately *not* the tracker's cylinder model: ellipsoids for the
+The rendered body is deliberately *not* the tracker's round-cone model: ellipsoids for the
 head, chest and pelvis, tapered round cones for the limbs and the neck, boxes for hands
 and feet. Each person gets random girth and proportions within human ranges and a set of
 clothing and skin colours.
