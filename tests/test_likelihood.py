@@ -551,6 +551,9 @@ def test_views_and_observations():
     assert view.roi == roi_from_mask(mask)
     obs = observation_from_views([view, view])
     assert obs.points.shape == (14, 3)  # 7 measured mask pixels per view
+    np.testing.assert_array_equal(obs.points[:7], view.points)  # the view's points, made once
+    assert view.points is view.points and not view.points.flags.writeable
+    np.testing.assert_allclose(view.points[:, 2], 2.0)  # camera at the origin looking along +z
     assert observation_from_views([view], max_points=3).points.shape == (3, 3)
     with pytest.raises(ValueError, match="mask"):
         View(camera, raw, mask[:, :4])

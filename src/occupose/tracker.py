@@ -71,7 +71,7 @@ from occupose.grid.observation import observations_from_depth, predicted_from_tr
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.tracking import BlobTracker
 from occupose.joints import NUM_JOINTS
-from occupose.likelihood import Observation, View, observation_from_views, point_distances, view_points
+from occupose.likelihood import Observation, View, observation_from_views, point_distances
 from occupose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.pose import PoseEstimator, PoseProblem
 from occupose.proposals import feet, unexplained_points
@@ -332,7 +332,7 @@ class _Person:
             square = abs(np.cos(heading) * ray[0] + np.sin(heading) * ray[1]) / max(float(np.hypot(*ray)), 1e-9)
             if view.camera.down_angle > SHAPE_LEVEL or square < np.cos(SHAPE_FRONTAL):
                 continue
-            points = view_points(view)
+            points = view.points
             measured = neck_and_shoulders(breadth_profile(points)) if len(points) >= TOP_RANK else None
             if measured is not None:
                 self.shapes.append(measured)
@@ -355,7 +355,7 @@ class _Person:
         legs = dims.ankle_height + dims.shin + dims.thigh
         if len(self.tops) >= STATURE_FRAMES or self.pose[self.model.dof("z")] < STATURE_UPRIGHT * legs:
             return
-        points = np.concatenate([view_points(view) for view in observation.views])
+        points = np.concatenate([view.points for view in observation.views])
         if len(points) < TOP_RANK:
             return
         self.tops.append(top_height(points[:, 2]) + TOP_BIAS)

@@ -26,7 +26,7 @@ from __future__ import annotations
 from occupose.likelihood.color import ColorLikelihood, color_cells
 from occupose.likelihood.combine import TERMS, Sum, sum_of
 from occupose.likelihood.free import FreeSpaceLikelihood
-from occupose.likelihood.observation import Observation, View, observation_from_views, roi_from_mask, view_points
+from occupose.likelihood.observation import Observation, View, observation_from_views, roi_from_mask
 from occupose.likelihood.points import PointsLikelihood, point_distances
 from occupose.likelihood.render import RenderLikelihood
 
@@ -53,5 +53,5 @@ def make_likelihood(name: str, observation: Observation, **options):
 __all__ = [
     "LIKELIHOODS", "TERMS", "ColorLikelihood", "FreeSpaceLikelihood", "Observation", "PointsLikelihood",
     "RenderLikelihood", "Sum", "View", "color_cells", "make_likelihood", "observation_from_views",
-    "point_distances", "roi_from_mask", "sum_of", "view_points",
+    "point_distances", "roi_from_mask", "sum_of",
 ]

@@ -96,6 +96,15 @@ class View:
         object.__setattr__(self, "color", color)
         object.__setattr__(self, "roi", (v0, v1, u0, u1))
 
+    @cached_property
+    def points(self) -> np.ndarray:
+        """(N, 3) world metres, read-only: the measured pixels (depth > 0) of the mask,
+        back-projected, row-major (made once: the observation and the tracker's size
+        measurements of a frame share them)."""
+        points = points_from_depth(np.where(self.mask, self.depth, 0.0), self.camera)[0]
+        points.flags.writeable = False
+        return points
+
 
 @dataclass(frozen=True, eq=False)
 class Observation:
@@ -125,12 +134,6 @@ class Observation:
         return blocked_points(self.points)
 
 
-def view_points(view: View) -> np.ndarray:
-    """(N, 3) world metres: the measured pixels (depth > 0) of a view's mask, back-projected,
-    row-major."""
-    return points_from_depth(np.where(view.mask, view.depth, 0.0), view.camera)[0]
-
-
 def observation_from_views(views, max_points: int = 2000) -> Observation:
     """The Observation whose points are the person's pixels of every view, back-projected.
 
@@ -146,7 +149,7 @@ def observation_from_views(views, max_points: int = 2000) -> Observation:
     for view in views:
         if not isinstance(view, View):
             raise ValueError(f"views must be a sequence of View, got a {type(view).__name__}")
-        chunks.append(view_points(view))
+        chunks.append(view.points)
     points = np.concatenate(chunks)
     if len(points) > max_points:
         points = points[np.linspace(0, len(points) - 1, max_points).round().astype(np.int64)]
