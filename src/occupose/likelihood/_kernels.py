@@ -72,6 +72,34 @@ def _capsule_constants(ax, ay, az, bx, by, bz, r1, r2):
 
 
 @numba.njit(cache=True, nogil=True)
+def _select(points, axis, order, lo, hi, kth):
+    """Reorder order[lo:hi] so that the entries before ``kth`` index the points with the
+    smallest coordinate ``axis`` and those from ``kth`` on the largest (quickselect,
+    median-of-three pivots)."""
+    while hi - lo > 1:
+        mid = lo + (hi - lo) // 2
+        x, y, z = points[order[lo], axis], points[order[mid], axis], points[order[hi - 1], axis]
+        pivot = max(min(x, y), min(max(x, y), z))
+        i, j = lo, hi - 1
+        while i <= j:
+            while points[order[i], axis] < pivot:
+                i += 1
+            while points[order[j], axis] > pivot:
+                j -= 1
+            if i <= j:
+                order[i], order[j] = order[j], order[i]
+                i += 1
+                j -= 1
+        # now order[lo:j + 1] <= pivot <= order[i:hi], and entries between equal the pivot
+        if kth <= j:
+            hi = j + 1
+        elif kth >= i:
+            lo = i
+        else:
+            return
+
+
+@numba.njit(cache=True, nogil=True)
 def block_order(points, block_size, order):
     """Split (N, 3) float64 points into spatially compact blocks of at most ``block_size``
     points: halve each set at the median of its longest side (the lower half first) until
@@ -96,14 +124,57 @@ def block_order(points, block_size, order):
                 high = max(high, points[order[i], k])
             if high - low > widest:
                 axis, widest = k, high - low
-        index = order[lo:hi].copy()
-        ranked = np.argsort(points[index, axis], kind="mergesort")
-        for i in range(hi - lo):
-            order[lo + i] = index[ranked[i]]
         half = lo + (hi - lo) // 2
+        _select(points, axis, order, lo, hi, half)
         stack.append((half, hi))
         stack.append((lo, half))
     return np.array(start, np.int64)
+
+
+@numba.njit(cache=True, nogil=True)
+def pack_blocks(points, order, leaf_start, pad, slack):
+    """The arrays of :class:`occupose.likelihood._capsules.PointBlocks` for (N, 3) float64
+    ``points`` split into blocks order[leaf_start[b]:leaf_start[b + 1]] (N >= 1), each
+    padded to a multiple of ``pad`` entries with copies of its last point (weight 0);
+    block radii get ``slack`` metres more. Returns origin (3,), px, py, pz (M,) float32,
+    start (B + 1,) int64, centre (3, B), radius (B,), weight (M,) float32, position (N,)."""
+    n, num_blocks = points.shape[0], leaf_start.shape[0] - 1
+    origin = np.zeros(3)
+    for i in range(n):
+        for k in range(3):
+            origin[k] += points[i, k]
+    origin /= n
+    start = np.zeros(num_blocks + 1, np.int64)
+    for block in range(num_blocks):
+        count = leaf_start[block + 1] - leaf_start[block]
+        start[block + 1] = start[block] + (count + pad - 1) // pad * pad
+    m = start[num_blocks]
+    px, py, pz = np.empty(m, np.float32), np.empty(m, np.float32), np.empty(m, np.float32)
+    weight = np.zeros(m, np.float32)
+    position = np.empty(n, np.int64)
+    centre, radius = np.empty((3, num_blocks)), np.empty(num_blocks)
+    for block in range(num_blocks):
+        first, last = leaf_start[block], leaf_start[block + 1]
+        low, high = np.full(3, np.inf), np.full(3, -np.inf)
+        for j in range(start[block], start[block + 1]):
+            i = order[min(first + j - start[block], last - 1)]
+            x, y, z = points[i, 0] - origin[0], points[i, 1] - origin[1], points[i, 2] - origin[2]
+            px[j], py[j], pz[j] = x, y, z
+            if j - start[block] < last - first:
+                weight[j] = 1.0
+                position[i] = j
+                low[0], low[1], low[2] = min(low[0], x), min(low[1], y), min(low[2], z)
+                high[0], high[1], high[2] = max(high[0], x), max(high[1], y), max(high[2], z)
+        for k in range(3):
+            centre[k, block] = 0.5 * (low[k] + high[k])
+        largest = 0.0
+        for i in order[first:last]:
+            squared = 0.0
+            for k in range(3):
+                squared += (points[i, k] - origin[k] - centre[k, block]) ** 2
+            largest = max(largest, squared)
+        radius[block] = math.sqrt(largest) + slack
+    return origin, px, py, pz, start, centre, radius, weight, position
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -253,37 +324,31 @@ def point_distance_sums(a, b, radii, capsule_part, origin, px, py, pz, block_sta
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def offset_depths(depth, table, slope, step, sign, out):
-    """out = depth + sign * tolerance(depth) where depth > 0, else 0 (float32, metres).
+def offset_depths(depth, c0, c1, c2, out):
+    """out = depth + c0 + c1 depth + c2 depth^2 where depth > 0, else 0 (float32, metres).
 
-    depth : (H, W) float32, metres; table : (T,) float32, the tolerance at depths 0, step,
-    2 step, ... metres, and slope : (T - 1,) float32 its differences, for linear
-    interpolation (the table must cover the depths: larger ones get the tolerance at
-    (T - 2) step); sign : +1.0 or -1.0; out : (H, W) float32. float32 throughout, so that
-    the loop vectorises.
+    depth : (H, W) float32, metres; c0, c1, c2 : float (the signed offset's quadratic in
+    depth); out : (H, W) float32. float32 throughout, so that the loop vectorises.
     """
-    last = np.float32(slope.shape[0] - 1)
-    inverse = np.float32(1.0 / step)
-    sign32 = np.float32(sign)
+    q0, q1, q2 = np.float32(c0), np.float32(1.0 + c1), np.float32(c2)
     for v in numba.prange(depth.shape[0]):
         for u in range(depth.shape[1]):
             d = depth[v, u]
-            x = min(d * inverse, last)
-            i = np.int32(x)
-            value = d + sign32 * (table[i] + (x - np.float32(i)) * slope[i])
+            value = q0 + d * (q1 + d * q2)
             out[v, u] = value if d > 0 else np.float32(0.0)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_around, samples):
     """Write the camera-facing samples of capsule ``c`` of particle ``p`` into ``samples``
     (3, 2 + T * A), camera-frame metres, x, y, z rows (rotation (3, 3), shift (3,):
     camera_from_world): first the point of each end sphere nearest the camera centre (the
     sphere's centre when the camera is inside it), then for each axis fraction ``along[j]``
     the points at the angles (cos_around, sin_around) about the axis, from the direction
-    facing the camera, on the circle of radius lerp(ra, rb, t) about lerp(a, b, t). Every
-    sample lies in the round cone. Only the two ends are transformed; the samples are
-    built in the camera frame, where the camera centre is the origin.
+    facing the camera, on the circle of radius lerp(ra, rb, t) about lerp(a, b, t) (that
+    direction, square to the axis, is the same all along it). Every sample lies in the
+    round cone. Only the two ends are transformed; the samples are built in the camera frame,
+    where the camera centre is the origin.
     """
     ra, rb = radii[c, 0], radii[c, 1]
     ax = rotation[0, 0] * a[p, c, 0] + rotation[0, 1] * a[p, c, 1] + rotation[0, 2] * a[p, c, 2] + shift[0]
@@ -306,27 +371,28 @@ def _camera_samples(a, b, radii, p, c, rotation, shift, along, cos_around, sin_a
         ex, ey, ez = dx * inverse, dy * inverse, dz * inverse
     else:  # the world's z axis
         ex, ey, ez = rotation[0, 2], rotation[1, 2], rotation[2, 2]
+    # n: towards the camera (-o, o any point of the axis), square to the axis; m = e x n.
+    ox, oy, oz = 0.5 * (ax + bx), 0.5 * (ay + by), 0.5 * (az + bz)
+    dot = -(ox * ex + oy * ey + oz * ez)
+    nx, ny, nz = -ox - dot * ex, -oy - dot * ey, -oz - dot * ez
+    norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if norm < 1e-9:  # camera on the axis: any square direction (the world's x or y axis)
+        world_x = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
+        k = 0 if abs(world_x) < 0.9 else 1
+        nx, ny, nz = rotation[0, k], rotation[1, k], rotation[2, k]
+        dot = nx * ex + ny * ey + nz * ez
+        nx, ny, nz = nx - dot * ex, ny - dot * ey, nz - dot * ez
+        norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+    inverse = 1.0 / norm
+    nx, ny, nz = nx * inverse, ny * inverse, nz * inverse
+    mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
     s = 2
     for j in range(along.shape[0]):
         t = along[j]
         ox, oy, oz = ax + t * dx, ay + t * dy, az + t * dz
         r = ra + t * (rb - ra)
-        # n: towards the camera (-o), square to the axis; m = e x n completes the frame.
-        dot = -(ox * ex + oy * ey + oz * ez)
-        nx, ny, nz = -ox - dot * ex, -oy - dot * ey, -oz - dot * ez
-        norm = math.sqrt(nx * nx + ny * ny + nz * nz)
-        if norm < 1e-9:  # camera on the axis: any square direction (the world's x or y axis)
-            world_x = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
-            k = 0 if abs(world_x) < 0.9 else 1
-            nx, ny, nz = rotation[0, k], rotation[1, k], rotation[2, k]
-            dot = nx * ex + ny * ey + nz * ez
-            nx, ny, nz = nx - dot * ex, ny - dot * ey, nz - dot * ez
-            norm = math.sqrt(nx * nx + ny * ny + nz * nz)
-        inverse = r / norm
-        nx, ny, nz = nx * inverse, ny * inverse, nz * inverse  # radius r
-        mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
         for i in range(cos_around.shape[0]):
-            co, si = cos_around[i], sin_around[i]
+            co, si = r * cos_around[i], r * sin_around[i]
             samples[0, s] = ox + co * nx + si * mx
             samples[1, s] = oy + co * ny + si * my
             samples[2, s] = oz + co * nz + si * mz

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from occupose.likelihood import _kernels
-from occupose.synth.noise import depth_std
+from occupose.synth.noise import depth_std_coefficients
 
 #: Angles of the samples about a capsule's axis, either side of the camera-facing direction,
 #: degrees: 45 keeps them inside the silhouette of a limb whose model is up to ~40 % too thick.
@@ -26,18 +24,6 @@ def sample_pattern(samples_along, samples_around):
     return along, np.cos(angles), np.sin(angles), 2 + int(samples_along) * int(samples_around)
 
 
-#: Depth step of the tolerance tables of :func:`offset_depths`, metres (the tolerance is
-#: quadratic in depth: linear interpolation is exact to a few nanometres).
-TOLERANCE_STEP = 0.001
-
-
-@functools.lru_cache(maxsize=16)
-def _tolerance_table(margin: float, noise: str, metres: int) -> tuple[np.ndarray, np.ndarray]:
-    depths = np.arange(int(round(metres / TOLERANCE_STEP)) + 2) * TOLERANCE_STEP
-    table = margin + 3.0 * depth_std(depths, noise)
-    return table.astype(np.float32), np.diff(table).astype(np.float32)
-
-
 def offset_depths(depth: np.ndarray, margin: float, noise: str, sign: float) -> np.ndarray:
     """(H, W) float32 metres: depth + sign * (``margin`` + 3 sigma of the ``noise`` model's
     random error at that depth) on measured pixels, 0 where depth is 0.
@@ -48,11 +34,11 @@ def offset_depths(depth: np.ndarray, margin: float, noise: str, sign: float) -> 
     margin = float(margin)
     if not (np.isfinite(margin) and margin >= 0):
         raise ValueError(f"margin must be a finite number >= 0 metres, got {margin!r}")
-    depth_std(1.0, noise)  # raises with the valid names
+    coefficients = 3.0 * depth_std_coefficients(noise)
+    coefficients[0] += margin
     depth = np.ascontiguousarray(depth, dtype=np.float32)
-    metres = int(np.ceil(depth.max())) if depth.size else 0
     out = np.empty(depth.shape, np.float32)
-    _kernels.offset_depths(depth, *_tolerance_table(margin, noise, max(metres, 1)), TOLERANCE_STEP, float(sign), out)
+    _kernels.offset_depths(depth, *(float(sign) * coefficients), out)
     return out
 
 

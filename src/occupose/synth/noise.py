@@ -52,12 +52,17 @@ def depth_std(z, model: str):
     0.3 z^2) mm (Fankhauser et al. 2015); ``"none"``: 0. Systematic (bias) errors of real
     sensors are not modelled.
     """
-    if model not in _STD_COEFFS:
-        raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(_STD_COEFFS)}")
-    c0, c1, c2 = _STD_COEFFS[model]
+    c0, c1, c2 = depth_std_coefficients(model)
     values = np.asarray(z, dtype=np.float64)
     std = c0 + c1 * values + c2 * values**2
     return float(std) if std.ndim == 0 else std
+
+
+def depth_std_coefficients(model: str) -> np.ndarray:
+    """(3,) float64 c0, c1, c2: :func:`depth_std` of ``model`` is c0 + c1 z + c2 z^2 metres."""
+    if model not in _STD_COEFFS:
+        raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(_STD_COEFFS)}")
+    return _STD_COEFFS[model].copy()
 
 
 def _check_depth(depth) -> np.ndarray:
