@@ -137,8 +137,13 @@ def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float,
     FLOOR_SLACK below ``floor`` (metres) costs its part FLOOR_COST nats per metre beyond."""
     lowest = np.minimum(a[..., 2] - model.capsule_radii[:, 0], b[..., 2] - model.capsule_radii[:, 1])
     sunk = np.maximum(floor - FLOOR_SLACK - lowest, 0.0)
-    if sunk.any():
-        np.add.at(out.T, model.capsule_part, -FLOOR_COST * sunk.T)
+    out -= FLOOR_COST * (sunk @ _part_matrix(model))
+
+
+@functools.lru_cache(maxsize=64)
+def _part_matrix(model: BodyModel) -> np.ndarray:
+    """(C, K) float64: 1 where capsule c belongs to part k (sums capsules into parts)."""
+    return (model.capsule_part[:, None] == np.arange(len(model.part_names))).astype(np.float64)
 
 
 def add_reach_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray, *,
