@@ -26,7 +26,7 @@ bends forwards.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
+from scipy.spatial.distance import cdist
 
 from occupose.body import LIMB_DOFS, BodyModel, capsules_from_poses, joints_from_poses, limb_angles
 from occupose.joints import JOINT_INDEX
@@ -186,5 +186,6 @@ def reach_towards(root: np.ndarray, end: np.ndarray, upper: float, lower: float,
     t = np.linspace(0.1, 0.9, 5)[None, :, None]
     samples = np.concatenate([root + t * (middles[:, None] - root),
                               middles[:, None] + t * (end - middles[:, None])], axis=1)  # (E, 10, 3)
-    nearest = cKDTree(points).query(samples.reshape(-1, 3))[0].reshape(samples.shape[:2])
+    squared = cdist(samples.reshape(-1, 3), points, "sqeuclidean").min(axis=1)  # quicker than a tree here
+    nearest = np.sqrt(squared).reshape(samples.shape[:2])
     return middles[np.argmin(nearest.mean(axis=1))], end
