@@ -201,6 +201,21 @@ def test_blocked_points_match_reference(rng):
     assert len(empty.px) == 0 and list(empty.block_start) == [0]
 
 
+def test_blocked_points_with_tied_coordinates(rng):
+    """Median splits by quickselect on points with many equal coordinates (a coarse grid,
+    duplicates): every point in exactly one block, halves of equal size, no block too big."""
+    from occupose.likelihood._capsules import blocked_points
+
+    points = rng.integers(0, 3, size=(700, 3)).astype(np.float64) * 0.1
+    points[:100] = points[0]  # 100 copies of one point
+    blocks = blocked_points(points, block_size=50, pad=8)
+    counts = np.add.reduceat(blocks.weight, blocks.block_start[:-1])
+    assert len(np.unique(blocks.position)) == 700 and np.all(blocks.weight[blocks.position] == 1)
+    assert counts.sum() == 700 and np.all(counts <= 50) and np.all(counts >= 43)  # 700 / 16
+    entries = np.stack([blocks.px, blocks.py, blocks.pz], axis=1).astype(np.float64) + blocks.origin
+    np.testing.assert_allclose(entries[blocks.position], points, atol=1e-6)
+
+
 def test_offset_depths_match_reference(rng):
     from occupose.likelihood._samples import offset_depths
     from occupose.synth.noise import depth_std
