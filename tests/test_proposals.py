@@ -9,7 +9,8 @@ from occupose.body import body_model, capsules_from_poses, joints_from_poses, st
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation
 from occupose.pose import PoseEstimator, PoseProblem
-from occupose.proposals import FOOT_LOST, feet, limb_dofs, limb_proposals, reach_towards, unexplained_points
+from occupose.proposals import (FOOT_LOST, feet, limb_dofs, limb_proposals, mirrored_legs, reach_towards,
+                                 unexplained_points)
 
 WRIST = JOINT_INDEX["right_wrist"]
 ANKLE = JOINT_INDEX["left_ankle"]
@@ -166,3 +167,64 @@ def test_reach_towards_bends_a_knee_forwards_where_nothing_is_seen():
         assert np.array_equal(end, ankle)
         assert (knee - hip) @ forward > 0.2  # of the 8 places on the circle, the most forwards
         assert abs(np.linalg.norm(knee - hip) - 0.45) < 1e-9
+
+
+@pytest.fixture(scope="module")
+def seated():
+    """(model, a still person seated (thighs forwards, knees bent), the pose with the right
+    thigh left hanging (its knee still bent), points on the seated pose)."""
+    model = body_model("full")
+    pose = standing_pose(model, (0.0, 2.5), 0.0)
+    pose[2] -= 0.4
+    for side in ("left", "right"):
+        pose[model.dof_names.index(f"{side}_hip_flex")] = 1.5
+        pose[model.dof_names.index(f"{side}_knee")] = 1.5
+    hanging = pose.copy()
+    hanging[model.dof_names.index("right_hip_flex")] = 0.1
+    return model, pose, hanging, _surface_points(model, pose, np.random.default_rng(2), 2000)
+
+
+def test_mirrored_legs_propose_each_leg_as_the_other_when_they_differ(seated):
+    model, pose, hanging, _ = seated
+    left, right = limb_dofs(model, "left", "leg"), limb_dofs(model, "right", "leg")
+    proposals = mirrored_legs(model, hanging)
+    assert [list(dofs) for dofs, _ in proposals] == [list(left), list(right)]
+    np.testing.assert_array_equal(proposals[0][1], hanging[right])
+    np.testing.assert_array_equal(proposals[1][1], hanging[left])
+    assert mirrored_legs(model, pose) == []  # alike
+    assert mirrored_legs(model, hanging, differ=1.5) == []  # 1.4 rad apart
+    assert len(mirrored_legs(model, hanging, floor=0.0)) == 2  # the hips 0.4 m below their reach
+    lifted = standing_pose(model, (0.0, 2.5), 0.0)
+    lifted[left[0]] = 0.8  # standing on the right leg
+    assert len(mirrored_legs(model, lifted)) == 2 and mirrored_legs(model, lifted, floor=0.0) == []
+    active = np.ones(model.num_dofs, bool)
+    active[[right[3], left[0]]] = False  # the right knee and left hip flex frozen
+    partial = mirrored_legs(model, hanging, active)
+    assert [list(dofs) for dofs, _ in partial] == [list(right[:3])]  # the left leg's other angles are alike
+    np.testing.assert_array_equal(partial[0][1], hanging[left[:3]])
+    assert mirrored_legs(body_model("upper"), standing_pose(body_model("upper"), (0.0, 2.5), 0.0)) == []
+
+
+def test_a_still_persons_hanging_thigh_is_found_from_the_other_leg(seated):
+    """A seated person's right thigh left hanging, its knee frozen (a hidden shin): six
+    frames of apf+ps 200 x [3, 1, 1] on the seated points. Measured knee error 52.0 cm
+    for a person not still (no leg proposals), the same for a still one without the
+    mirrored legs (the feet's proposals alone), 1.6 cm with them; the knee's angle is
+    never set."""
+    model, pose, hanging, points = seated
+    active = np.ones(model.num_dofs, bool)
+    active[model.dof_names.index("right_knee")] = False
+    knee = JOINT_INDEX["right_knee"]
+    true_knee = joints_from_poses(model, pose[None])[0, knee]
+    errors = {}
+    for mirror in (False, True):
+        estimator = PoseEstimator(PoseProblem(model, "points"), "apf+ps", 200, np.random.default_rng(0),
+                                  num_layers=[3, 1, 1])
+        estimator.problem.standing = mirror
+        estimator.initialise(hanging, 0.0)
+        for _ in range(6):
+            found = estimator.step(Observation(points, ()), active=active)
+        assert found[model.dof_names.index("right_knee")] == hanging[model.dof_names.index("right_knee")]
+        errors[mirror] = np.linalg.norm(joints_from_poses(model, found[None])[0, knee] - true_knee)
+    assert errors[False] > 0.3, errors
+    assert errors[True] < 0.05, errors

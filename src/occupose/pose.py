@@ -15,7 +15,7 @@ import numpy as np
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
 from occupose.filters import apply_limits, make_filter
 from occupose.likelihood import Observation, make_likelihood
-from occupose.proposals import limb_proposals
+from occupose.proposals import limb_proposals, mirrored_legs
 
 
 #: Default share of the particles given to each limb proposal (see PoseEstimator).
@@ -244,7 +244,9 @@ class PoseEstimator:
     rng : np.random.Generator; velocity_damping : share of the root's last translation
     added to every particle before a step (constant-velocity prediction; 0 = none);
     proposals : share of the particles whose arm or leg tries where the points unexplained
-    by the last estimate suggest, per limb (:func:`occupose.proposals.limb_proposals`; 0 = none);
+    by the last estimate suggest, per limb (:func:`occupose.proposals.limb_proposals`), and
+    whose leg tries the other leg's angles for a still person with bent legs
+    (:func:`occupose.proposals.mirrored_legs`; 0 = none);
     filter_options : e.g. ``num_layers``
     """
 
@@ -299,12 +301,17 @@ class PoseEstimator:
 
     def _propose(self, current: np.ndarray, observation: Observation, active: np.ndarray | None) -> None:
         """Set the DOFs of a random share of the particles to each limb proposal (models with
-        arms) and to the heading of the way walked, where every DOF set is active."""
-        proposals = limb_proposals(self.problem.model, current, observation, legs=self.problem.standing,
+        arms) and to the heading of the way walked, where every DOF set is active, and, for
+        a still person seated or crouching, each leg's active DOFs to the other leg's
+        (:func:`mirrored_legs`)."""
+        model = self.problem.model
+        proposals = limb_proposals(model, current, observation, legs=self.problem.standing,
                                    floor=self.problem.floor) if self._has_arms else []
         if self.problem.walking is not None and self.problem.heading_dof is not None:
             proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
         proposals = [(dofs, values) for dofs, values in proposals if active is None or active[dofs].all()]
+        if self.problem.standing:
+            proposals += mirrored_legs(model, current, active, floor=self.problem.floor)
         if not proposals:
             return
         count = int(round(self.proposals * self.filter.num_particles))
