@@ -195,10 +195,27 @@ def test_blocked_points_match_reference(rng):
         assert sorted(blocks.position[leaf]) == list(range(lo, lo + len(leaf)))  # the same points, first
         np.testing.assert_array_equal(blocks.weight[lo:hi], np.arange(hi - lo) < len(leaf))
         assert np.all(entries[lo + len(leaf):hi] == entries[lo + len(leaf) - 1])  # padding: the last point
+        box = points[leaf] - blocks.origin
+        np.testing.assert_allclose(blocks.block_centre[:, b], (box.min(axis=0) + box.max(axis=0)) / 2, atol=1e-12)
         ball = np.linalg.norm(points[leaf] - blocks.origin - blocks.block_centre[:, b], axis=1)
         np.testing.assert_allclose(blocks.block_radius[b], ball.max() + 1e-5, atol=1e-9)
     empty = blocked_points(np.zeros((0, 3)))
     assert len(empty.px) == 0 and list(empty.block_start) == [0]
+
+
+def test_select_partitions_around_the_kth_with_ties(rng):
+    """The quickselect of the median splits against the order statistics, on keys with
+    many ties (only 4 distinct values) and on distinct ones, for several k."""
+    from occupose.likelihood._kernels import _select
+
+    for points in (rng.integers(0, 4, size=(301, 3)).astype(np.float64), rng.normal(size=(301, 3))):
+        for lo, hi, kth in ((0, 301, 150), (17, 280, 20), (17, 280, 279), (100, 102, 101)):
+            order = np.arange(301)
+            _select(points, 1, order, lo, hi, kth)
+            keys = points[order, 1]
+            assert sorted(order[lo:hi]) == list(range(lo, hi))  # a permutation of the range
+            assert keys[lo:kth].max(initial=-np.inf) <= keys[kth] <= keys[kth:hi].min()
+            assert keys[kth] == np.sort(points[lo:hi, 1])[kth - lo]
 
 
 def test_blocked_points_with_tied_coordinates(rng):

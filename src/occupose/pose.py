@@ -311,7 +311,7 @@ class PoseEstimator:
             proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
         proposals = [(dofs, values) for dofs, values in proposals if active is None or active[dofs].all()]
         if self.problem.standing:
-            proposals += mirrored_legs(model, current, active, floor=self.problem.floor)
+            proposals += mirrored_legs(model, current, active, self.problem.floor)
         if not proposals:
             return
         count = int(round(self.proposals * self.filter.num_particles))

@@ -107,15 +107,15 @@ def limb_proposals(model: BodyModel, pose: np.ndarray, observation: Observation,
     return proposals
 
 
-def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None = None, *,
-                  floor: float | None = None, differ: float = MIRROR_DIFFER) -> list[tuple[np.ndarray, np.ndarray]]:
+def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None, floor: float | None, *,
+                  differ: float = MIRROR_DIFFER) -> list[tuple[np.ndarray, np.ndarray]]:
     """Each leg set as the other one is: its hip flex, abd, rot and knee (the model's DOFs
     mirror left and right) that ``active`` (D,) bool allows (default all; a hidden shin's
-    knee is frozen), when they differ from the other leg's of ``pose`` (D,) by more than
-    ``differ`` radians in some DOF and, given the ``floor``'s height (metres), the hips
-    are more than :data:`MIRROR_BENT` below a straight leg's reach above it (seated or
-    crouching). Returns a list of (dofs (n,) int64, values (n,) float64), at most one per
-    leg ([] for a model without legs).
+    knee is frozen; None: all), when they differ from the other leg's of ``pose`` (D,) by
+    more than ``differ`` radians in some DOF and the hips are more than
+    :data:`MIRROR_BENT` below a straight leg's reach above the ``floor`` (its height,
+    metres; seated or crouching). Returns a list of (dofs (n,) int64, values (n,)
+    float64), at most one per leg ([] for a model without legs or without a floor).
 
     A thigh with few points of its own (behind the other leg from one camera, behind a
     table from the other) was left hanging while the person sat down, as nothing seen
@@ -123,17 +123,23 @@ def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None 
     Standing, the legs show themselves; proposed there too, the mirrored legs cost the
     torso's search particles behind a chair (8.4 -> 8.8 cm over 6 runs).
     """
-    if "left_hip_flex" not in model.dof_names:
+    pose = np.asarray(pose, dtype=np.float64)
+    if pose.shape != (model.num_dofs,):
+        raise ValueError(f"pose must have shape ({model.num_dofs},), got {pose.shape}")
+    if active is not None:
+        active = np.asarray(active)
+        if active.shape != (model.num_dofs,) or active.dtype != bool:
+            raise ValueError(f"active must be a ({model.num_dofs},) bool array, got {active.dtype} {active.shape}")
+    if "left_hip_flex" not in model.dof_names or floor is None:
         return []
-    if floor is not None:
-        joints = joints_from_poses(model, pose[None])[0]
-        hips = min(joints[JOINT_INDEX[f"{side}_hip"], 2] for side in SIDES) - floor
-        if hips > model.dims.thigh + model.dims.shin + model.dims.ankle_height - MIRROR_BENT:
-            return []
+    joints = joints_from_poses(model, pose[None])[0]
+    hips = min(joints[JOINT_INDEX[f"{side}_hip"], 2] for side in SIDES) - floor
+    if hips > model.dims.thigh + model.dims.shin + model.dims.ankle_height - MIRROR_BENT:
+        return []
     proposals = []
     for side, other in (("left", "right"), ("right", "left")):
         dofs, source = limb_dofs(model, side, "leg"), limb_dofs(model, other, "leg")
-        keep = np.ones(len(dofs), bool) if active is None else np.asarray(active)[dofs]
+        keep = np.ones(len(dofs), bool) if active is None else active[dofs]
         if keep.any() and np.max(np.abs(pose[dofs[keep]] - pose[source[keep]])) > differ:
             proposals.append((dofs[keep], pose[source[keep]].copy()))
     return proposals

@@ -73,9 +73,10 @@ def _capsule_constants(ax, ay, az, bx, by, bz, r1, r2):
 
 @numba.njit(cache=True, nogil=True)
 def _select(points, axis, order, lo, hi, kth):
-    """Reorder order[lo:hi] so that the entries before ``kth`` index the points with the
-    smallest coordinate ``axis`` and those from ``kth`` on the largest (quickselect,
-    median-of-three pivots)."""
+    """Reorder order[lo:hi] so that order[kth] indexes the point whose coordinate ``axis``
+    is the (kth - lo)-th smallest of the range, the entries before it points no larger and
+    those after it points no smaller (quickselect, median-of-three pivots). points : (N, 3)
+    float64; order : (N,) int64, indices into points, reordered in place; lo <= kth < hi."""
     while hi - lo > 1:
         mid = lo + (hi - lo) // 2
         x, y, z = points[order[lo], axis], points[order[mid], axis], points[order[hi - 1], axis]
@@ -136,8 +137,11 @@ def pack_blocks(points, order, leaf_start, pad, slack):
     """The arrays of :class:`occupose.likelihood._capsules.PointBlocks` for (N, 3) float64
     ``points`` split into blocks order[leaf_start[b]:leaf_start[b + 1]] (N >= 1), each
     padded to a multiple of ``pad`` entries with copies of its last point (weight 0);
-    block radii get ``slack`` metres more. Returns origin (3,), px, py, pz (M,) float32,
-    start (B + 1,) int64, centre (3, B), radius (B,), weight (M,) float32, position (N,)."""
+    block radii get ``slack`` metres more. Returns origin (3,) float64 (the points'
+    centroid), px, py, pz (M,) float32 (points minus origin), start (B + 1,) int64, centre
+    (3, B) float64 (the middle of each block's bounding box, minus origin), radius (B,)
+    float64, weight (M,) float32, position (N,) int64; metres as the points. Allocates its
+    outputs: their sizes come from the blocks' padded counts."""
     n, num_blocks = points.shape[0], leaf_start.shape[0] - 1
     origin = np.zeros(3)
     for i in range(n):
@@ -328,7 +332,8 @@ def offset_depths(depth, c0, c1, c2, out):
     """out = depth + c0 + c1 depth + c2 depth^2 where depth > 0, else 0 (float32, metres).
 
     depth : (H, W) float32, metres; c0, c1, c2 : float (the signed offset's quadratic in
-    depth); out : (H, W) float32. float32 throughout, so that the loop vectorises.
+    depth); out : (H, W) float32. float32 throughout, so that the loop vectorises (exact to
+    about 1 micrometre at 7.5 m).
     """
     q0, q1, q2 = np.float32(c0), np.float32(1.0 + c1), np.float32(c2)
     for v in numba.prange(depth.shape[0]):
