@@ -52,6 +52,8 @@ def test_default_body_is_an_average_adult():
     dims = m.BodyDims()
     assert dims.height == pytest.approx(1.72)
     j = m.joints_from_pose(m.standing_pose())
+    assert dims.hip_height == pytest.approx(0.92)
+    assert j[J["left_hip"], 2] == pytest.approx(dims.hip_height, abs=1e-3)  # the knees barely bent
     assert j.shape == (15, 3) and j.dtype == np.float64
     assert j[J["left_ankle"], 2] == pytest.approx(0.08, abs=1e-9)
     assert j[J["pelvis"], 2] == pytest.approx(0.92, abs=0.005)

@@ -134,7 +134,7 @@ def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None,
         return []
     joints = joints_from_poses(model, pose[None])[0]
     hips = min(joints[JOINT_INDEX[f"{side}_hip"], 2] for side in SIDES) - floor
-    if hips > model.dims.thigh + model.dims.shin + model.dims.ankle_height - MIRROR_BENT:
+    if hips > model.dims.hip_height - MIRROR_BENT:
         return []
     proposals = []
     for side, other in (("left", "right"), ("right", "left")):

@@ -352,8 +352,7 @@ class _Person:
         Then the stature is known (PoseProblem.stature_known: the upper body's head may
         not rise above it)."""
         dims = self.model.dims
-        legs = dims.ankle_height + dims.shin + dims.thigh
-        if len(self.tops) >= STATURE_FRAMES or self.pose[self.model.dof("z")] < STATURE_UPRIGHT * legs:
+        if len(self.tops) >= STATURE_FRAMES or self.pose[self.model.dof("z")] < STATURE_UPRIGHT * dims.hip_height:
             return
         points = np.concatenate([view.points for view in observation.views])
         if len(points) < TOP_RANK:

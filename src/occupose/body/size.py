@@ -101,7 +101,7 @@ def _model_breadth(model: BodyModel, height: float) -> float:
     """Breadth of the standing model at ``height`` metres above the floor (arms at rest), metres."""
     pose = np.zeros(model.num_dofs)
     dims = model.dims
-    pose[model.dof("z")] = dims.ankle_height + dims.thigh + dims.shin
+    pose[model.dof("z")] = dims.hip_height
     for side in ("left", "right"):
         for name, value in zip(("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow"), ARM_REST):
             pose[model.dof(f"{side}_{name}")] = value
@@ -220,5 +220,4 @@ def dims_with_shoulders(dims: BodyDims, girth: float, neck_depth: float, shoulde
     depth = float(np.clip(neck_depth, *(f * 2.0 * average.neck_head for f in SHAPE_RANGE)))
     arm = FULL_RADII["upper_arm"][0] * girth
     width = float(np.clip(0.5 * shoulder_breadth - arm, *(f * average.shoulder_width for f in SHAPE_RANGE)))
-    legs = dims.ankle_height + dims.shin + dims.thigh
-    return replace(dims, spine=dims.height - legs - depth, neck_head=0.5 * depth, shoulder_width=width)
+    return replace(dims, spine=dims.height - dims.hip_height - depth, neck_head=0.5 * depth, shoulder_width=width)

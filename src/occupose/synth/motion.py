@@ -77,9 +77,14 @@ class BodyDims:
                 raise ValueError(f"BodyDims.{name} must be > 0 metres, got {getattr(self, name)!r}")
 
     @property
+    def hip_height(self) -> float:
+        """The hip joints above the floor standing with straight legs, metres."""
+        return self.ankle_height + self.shin + self.thigh
+
+    @property
     def height(self) -> float:
         """Standing height (floor to top of the head), metres."""
-        return self.ankle_height + self.shin + self.thigh + self.spine + 2.0 * self.neck_head
+        return self.hip_height + self.spine + 2.0 * self.neck_head
 
     def scaled(self, height: float) -> BodyDims:
         """The same proportions scaled to a standing height of ``height`` metres."""
