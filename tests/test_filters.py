@@ -10,6 +10,7 @@ from occupose.filters import (FILTERS, RESAMPLING, ess, filter_options, make_fil
                               resample)
 from occupose.filters import _kernels
 from occupose.filters.base import apply_limits, limit_modes
+from occupose.filters.layered import spread_layers
 
 
 @dataclass
@@ -338,6 +339,22 @@ def test_apf_ps_layers_per_partition():
     pf.initialise(np.zeros(3), 0.1)
     pf.step()
     assert pf.diagnostics["likelihood_evaluations"] == 50 * 6
+
+
+def test_an_idle_partition_gives_its_layers_to_the_others():
+    """Legs hidden behind a table: their stage's 2 layers go to the others, (3, 2) not (2, 1)."""
+    assert spread_layers(5, 2) == (3, 2) and spread_layers(5, 3) == (2, 2, 1) and spread_layers(2, 3) == (1, 1, 0)
+    problem = Separable(num_parts=3, width=2)
+    pf = make_filter("apf+ps", problem, 50, np.random.default_rng(0), num_layers=[2, 1, 2])
+    pf.initialise(np.zeros(6), 0.1)
+    active = np.array([True, True, True, True, False, False])
+    pf.step(active=active)
+    assert pf.diagnostics["likelihood_evaluations"] == 50 * 5  # as with every part in view
+    assert len(pf.diagnostics["betas"]) == 5
+    pf.step(active=np.array([False, False, True, True, False, False]))
+    assert pf.diagnostics["likelihood_evaluations"] == 50 * 5  # one stage left: all 5 layers
+    pf.step()
+    assert pf.diagnostics["likelihood_evaluations"] == 50 * 5 and pf.num_layers == [2, 1, 2]
 
 
 def _track(name, problem, n, seed, steps, **options):

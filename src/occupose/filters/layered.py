@@ -23,6 +23,12 @@ its children, so the search of a limb starts from a good torso. ``apf+ps`` runs 
 annealing layers inside each partition (the first paper's hierarchical filter, after
 Bandouch et al. 2008). The final weights are the last layer's; resampling happens at the
 start of the next layer or frame, so ``log_weights`` always weight ``particles``.
+
+A stage none of whose DOFs is active in a step (``step(active=...)``: the legs hidden
+behind a table, left out by the occlusion handling) gives its layers to the stages that
+are, spread from the first down (:func:`spread_layers`), so every frame costs the same
+likelihood evaluations: the first paper's 200 x 5 budget searches the visible body with
+all of it instead of dropping the idle stage's share.
 """
 
 from __future__ import annotations
@@ -34,6 +40,12 @@ import numpy as np
 
 from occupose.filters import _kernels
 from occupose.filters.base import ParticleFilter, Problem, check_groups
+
+
+def spread_layers(total: int, stages: int) -> tuple[int, ...]:
+    """``total`` layers over ``stages`` stages as evenly as it goes, the first ones taking
+    the remainder: spread_layers(5, 2) == (3, 2)."""
+    return tuple(total // stages + (k < total % stages) for k in range(stages))
 
 
 class _LayeredFilter(ParticleFilter):
@@ -57,10 +69,24 @@ class _LayeredFilter(ParticleFilter):
             raise ValueError(f"survival (the target particle survival rate) must be in (0, 1), got {survival!r}")
         self.survival = float(survival)
 
+    def _layers(self, active: np.ndarray) -> list[int]:
+        """Layers per stage this step: a stage with no ``active`` (D,) bool DOF (parts hidden
+        by furniture, left out) gives its layers to the others, the total spread over them
+        from the first down as evenly as it goes ((2, 1, 2) with the last idle: (3, 2, 0)),
+        so a frame costs the same likelihood evaluations."""
+        live = [k for k, (dofs, _) in enumerate(self.stages) if active[dofs].any()]
+        if len(live) in (0, len(self.stages)):
+            return self.num_layers
+        layers = [0] * len(self.stages)
+        for k, count in zip(live, spread_layers(sum(self.num_layers), len(live))):
+            layers[k] = count
+        return layers
+
     def _step(self, std: np.ndarray, active: np.ndarray) -> None:
         diagnostics = self.diagnostics
         values = None
-        for (dofs, parts), num_layers in zip(self.stages, self.num_layers):
+        layers = self._layers(active)
+        for (dofs, parts), num_layers in zip(self.stages, layers):
             dofs = dofs[active[dofs]]
             if dofs.size == 0:
                 continue
