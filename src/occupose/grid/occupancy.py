@@ -112,7 +112,7 @@ import numpy as np
 from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
-from occupose.synth.noise import depth_std
+from occupose.synth.noise import depth_std, depth_std_coefficients
 
 #: Cell states (index into the last axis of ``OccupancyGrid.probabilities``).
 O, M, E = 0, 1, 2
@@ -458,7 +458,7 @@ class OccupancyGrid:
         for cam in self.cameras:
             preset = _preset_of(cam)
             model = noise_models.get(cam.name, preset.noise if preset is not None else DEFAULT_NOISE_MODEL)
-            depth_std(1.0, model)  # raises with the valid names
+            depth_std_coefficients(model)  # raises with the valid names
             self.noise_models[cam.name] = model
         _check_coverage(spec, self.cameras, _max_ranges(self.cameras, max_range))
         self._camera_arrays()
