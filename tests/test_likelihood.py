@@ -350,7 +350,6 @@ def test_free_space_matches_reference(rng):
     assert np.any(want > 0.05) and np.all(got[:, 2] == 0.0)
 
 
-
 def test_camera_samples_of_a_capsule_on_the_cameras_axis():
     """A ceiling camera straight above a vertical limb (a standing person's forearm from
     above): no direction towards the camera is square to the axis, so the samples' ring

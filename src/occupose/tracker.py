@@ -65,11 +65,11 @@ from occupose.body.size import (
     top_height,
 )
 from occupose.camera import Camera
+from occupose.filters.layered import spread_layers
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.observation import observations_from_depth, predicted_from_tracks
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
-from occupose.filters.layered import spread_layers
 from occupose.grid.tracking import BlobTracker
 from occupose.joints import NUM_JOINTS
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
