@@ -18,9 +18,10 @@ Legs the same way, from their feet (:func:`feet`), for a person who stands (a wa
 foot leaves the floor): a leg behind furniture (a chair's back) whose foot shows below it
 has few points of its own, and drifts where nothing is seen. The unexplained points less
 than :data:`FOOT_HEIGHT` above the floor nearer one hip than the other (across the floor)
-and within reach of it are that leg's foot: when it is more than :data:`FOOT_LOST` from
-the leg's ankle, the ankle is put at their median, at the ankle's height, and the knee
-bends forwards.
+and within reach of it show that leg's foot, and the ankle lies behind the median of
+the foot's points (the toes are ahead of it, and a camera sees the foot's near side): when
+it is more than :data:`FOOT_LOST` from the leg's ankle, the leg reaches it, the knee bent
+forwards.
 
 And a still person's legs as each other when they are bent (seated or crouching;
 :func:`mirrored_legs`): a thigh with few points of its own (behind the other leg from one
@@ -45,9 +46,14 @@ MIN_POINTS = 10
 REACH = 1.25
 #: Height, metres above the floor, below which unexplained points are taken as a foot.
 FOOT_HEIGHT = 0.2
+#: How far the points of a foot lie ahead of its ankle, metres: a foot's centre (the toes
+#: reach some 0.2 m beyond the ankle, the heel 0.05 m behind it).
+FOOT_AHEAD = 0.07
+#: A foot's points lie within this of their median across the floor, metres.
+FOOT_RADIUS = 0.2
 #: A leg is proposed only when its foot is farther than this from its ankle across the
 #: floor, metres: our legs have no feet, so the toes' points of a leg in the right place are
-#: unexplained too, and would pull its ankle forwards.
+#: unexplained too; a foot found nearer its ankle is left to the filter.
 FOOT_LOST = 0.15
 SIDES = ("left", "right")
 #: Joints of each limb from its root: (root, middle, end).
@@ -97,7 +103,8 @@ def limb_proposals(model: BodyModel, pose: np.ndarray, observation: Observation,
     joints = joints_from_poses(model, pose[None])[0]
     proposals = _arm_proposals(model, pose, joints, points, loose, min_points)
     if legs and floor is not None and "left_hip_flex" in model.dof_names:
-        for side, ankle in feet(model, pose, loose, floor, min_points).items():
+        viewpoints = np.array([view.camera.position for view in observation.views]).reshape(-1, 3)
+        for side, ankle in feet(model, pose, loose, floor, min_points, points=points, viewpoints=viewpoints).items():
             hip, thigh, shin = _limb(joints, side, "leg")
             if np.linalg.norm(ankle[:2] - joints[JOINT_INDEX[f"{side}_ankle"], :2]) < FOOT_LOST:
                 continue
@@ -146,17 +153,27 @@ def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None,
 
 
 def feet(model: BodyModel, pose: np.ndarray, loose: np.ndarray, floor: float,
-         min_points: int = MIN_POINTS) -> dict[str, np.ndarray]:
+         min_points: int = MIN_POINTS, *, points: np.ndarray | None = None,
+         viewpoints: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Where the feet that ``loose`` points (M, 3) show put the ankles: side -> (3,) metres.
 
-    A leg's foot is its ``min_points`` or more points less than :data:`FOOT_HEIGHT` above
-    ``floor``, nearer its hip than the other across the floor and within reach of it
-    (:data:`REACH` times the leg's length); its ankle is at their median, at the model's
-    ankle height. model : a model with legs; pose : (D,) the current estimate.
+    A leg's foot is its ``min_points`` or more loose points less than :data:`FOOT_HEIGHT`
+    above ``floor``, nearer its hip than the other across the floor and within reach of it
+    (:data:`REACH` times the leg's length). The loose points of a foot are what ``pose``
+    leaves unexplained, its toes for a leg in about the right place, so the foot is all of
+    ``points`` (N, 3) (the person's, default ``loose``) below that height within
+    :data:`FOOT_RADIUS` across the floor of their median. Its ankle is behind their median:
+    by :data:`FOOT_AHEAD` against the way ``pose`` faces, and by the shin's radius at the
+    ankle away from the nearest of ``viewpoints`` (V, 3) (the cameras' positions, world
+    metres: a camera sees the near side of a foot), at the model's ankle height.
+    model : a model with legs; pose : (D,) the current estimate.
     """
     low = loose[loose[:, 2] < floor + FOOT_HEIGHT]
     if len(low) < min_points:
         return {}
+    points = loose if points is None else points
+    near_floor = points[points[:, 2] < floor + FOOT_HEIGHT]
+    viewpoints = np.zeros((0, 3)) if viewpoints is None else np.asarray(viewpoints, float).reshape(-1, 3)
     joints = joints_from_poses(model, pose[None])[0]
     hips = np.array([joints[JOINT_INDEX[f"{side}_hip"]] for side in SIDES])
     nearer = np.argmin(np.linalg.norm(low[:, None, :2] - hips[None, :, :2], axis=2), axis=1)
@@ -164,9 +181,17 @@ def feet(model: BodyModel, pose: np.ndarray, loose: np.ndarray, floor: float,
     for s, side in enumerate(SIDES):
         hip, thigh, shin = _limb(joints, side, "leg")
         mine = (nearer == s) & (np.linalg.norm(low - hip, axis=1) < REACH * (thigh + shin))
-        if mine.sum() >= min_points:
-            found[side] = np.median(low[mine], axis=0)
-            found[side][2] = floor + model.dims.ankle_height
+        if mine.sum() < min_points:
+            continue
+        centre = np.median(low[mine], axis=0)
+        foot = near_floor[np.linalg.norm(near_floor[:, :2] - centre[:2], axis=1) < FOOT_RADIUS]
+        ankle = (np.median(foot, axis=0) if len(foot) else centre) - FOOT_AHEAD * forward(model, pose)
+        if len(viewpoints):
+            away = ankle[:2] - viewpoints[np.argmin(np.linalg.norm(viewpoints[:, :2] - ankle[:2], axis=1)), :2]
+            radius = model.capsule_radii[model.capsule_part == model.part_names.index(f"{side}_shin"), 1].max()
+            ankle[:2] += radius * away / max(float(np.linalg.norm(away)), 1e-9)
+        ankle[2] = floor + model.dims.ankle_height
+        found[side] = ankle
     return found
 
 

@@ -786,7 +786,8 @@ class Tracker:
             shins = [side for side in ("left", "right") if hidden[f"{side}_shin"] and not hidden[f"{side}_thigh"]]
             if legs or shins:
                 floor = person.problem.floor
-                shown = feet(person.model, pose, unexplained_points(person.model, pose, seen), floor) \
+                shown = feet(person.model, pose, unexplained_points(person.model, pose, seen), floor,
+                             points=seen.points, viewpoints=np.array([c.position for c in self.cameras])) \
                     if floor is not None and person.problem.standing else {}
                 pose = planted_legs(person.model, pose, legs, shins, shown)
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
