@@ -129,7 +129,8 @@ def _foot_points(model, pose, rng, count=150):
     boxes 0.25 x 0.09 x 0.076 m on the floor, from 0.055 m behind each ankle to 0.195 m
     ahead of it the way the pose faces, as the synthetic body's."""
     joints = joints_from_poses(model, pose[None])[0]
-    ahead = np.array([np.cos(pose[model.dof_names.index("heading")]), np.sin(pose[model.dof_names.index("heading")]), 0])
+    heading = pose[model.dof_names.index("heading")]
+    ahead, left = np.array([np.cos(heading), np.sin(heading)]), np.array([-np.sin(heading), np.cos(heading)])
     out = []
     for side in ("left", "right"):
         ankle = joints[JOINT_INDEX[f"{side}_ankle"]]
@@ -137,8 +138,7 @@ def _foot_points(model, pose, rng, count=150):
         along = np.where(face == 2, 0.195, -0.055 + 0.25 * u)  # the top, a side, the toes
         across = np.where(face == 1, 0.045 * np.sign(v - 0.5), 0.09 * (v - 0.5))
         up = np.where(face == 0, 0.076, 0.076 * v)
-        out.append(np.column_stack([ankle[:2] + along[:, None] * ahead[:2] + across[:, None] * ahead[[1, 0]] * [-1, 1],
-                                    up]))
+        out.append(np.column_stack([ankle[:2] + along[:, None] * ahead + across[:, None] * left, up]))
     return np.concatenate(out)
 
 
