@@ -11,11 +11,12 @@ from click.testing import CliRunner
 
 from occupose.cli import main
 from occupose.evaluate import (
-    RunResult, evaluate, hidden_share, intervals_from_mask, mean_row, per_joint_table, render_recording,
+    RunResult, arm_points, evaluate, hidden_share, intervals_from_mask, mean_row, per_joint_table, render_recording,
     report_markdown, results_table, table_rows, write_results_csv,
 )
 from occupose.joints import JOINTS
-from occupose.metrics import PersonScore, Score, TableRow
+from occupose.metrics import PersonScore, Score, TableRow, arm_epsilons, read_tracks_csv
+from occupose.recording import Recording
 
 FRAMES = 20
 
@@ -86,6 +87,24 @@ def test_report_bolds_the_best_mean_per_sequence_and_names_failed_runs(runs, tmp
     assert joints["head"]["ours"] == pytest.approx(np.mean([8, 10, 7, 30]))
     assert "| head | 13.75 | **11.75** |" in report
     assert "| ours | 20.0 | 50.0 | 10.0 | 20.0 |" in report  # each run: 4.95 s over 99 frames after the first
+
+
+def test_report_has_the_arm_error_of_runs_with_part_labels_only(runs):
+    assert "## Arm error" not in report_markdown(runs)
+    truth = np.full((100, 1), 0.05)
+
+    def with_arms(run, centimetres):
+        tracked = np.full((100, 1), centimetres / 100.0)
+        tracked[:10] = np.nan  # frames without an estimate or arm points are left out
+        return replace(run, arm_epsilon=tracked, truth_arm_epsilon=truth)
+
+    sit = [with_arms(r, cm) for r, cm in zip(runs[:4], (6.0, 8.0, 9.0, 12.0))]
+    report = report_markdown(sit + runs[4:])
+    assert "| sit | **7.00** | 10.50 | 5.00 |" in report
+    assert "| cross" not in report.split("## Arm error")[1].split("##")[0]
+    rows = results_table(sit)
+    assert [r["arm_eps_cm"] for r in rows] == pytest.approx([6.0, 8.0, 9.0, 12.0])
+    assert [r["truth_arm_eps_cm"] for r in rows] == pytest.approx([5.0] * 4)
 
 
 def test_per_joint_table_leaves_unreported_joints_out():
@@ -160,8 +179,17 @@ def test_evaluate_writes_runs_results_report_and_plots(evaluated):
         rows = list(csv.DictReader(handle))
     assert [(r["scenario"], r["method"], r["seed"], r["person"]) for r in rows] == [("no_occlusion", "ours", "0", "1")]
     assert 0 < float(rows[0]["mean_cm"]) < 20 and rows[0]["fail"] == "0" and float(rows[0]["fps"]) > 0
+    # the arm error of the ground truth is about an arm's radius (4-5 cm) plus the hands beyond
+    # the wrists; the track's is its own, from its tracks.csv and the recording's arm pixels
+    truth_eps, eps = float(rows[0]["truth_arm_eps_cm"]), float(rows[0]["arm_eps_cm"])
+    assert 3.0 < truth_eps < 7.0 and truth_eps < eps < truth_eps + 5.0
+    rec = Recording(out / "recordings" / "no_occlusion")
+    arms = arm_points(rec, rec.groundtruth().person_ids)
+    (track,) = read_tracks_csv(out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv", FRAMES).values()
+    assert 100 * np.nanmean(arm_epsilons(arms[0], track[0])) == pytest.approx(eps, abs=1e-4)
     report = (out / "report.md").read_text()
     assert "| no_occlusion | ours |" in report and "**" in report
+    assert f"| no_occlusion | {eps:.2f} | {truth_eps:.2f} |" in report
     for name in ("error_no_occlusion.png", "error_vs_time.png"):
         assert (out / name).stat().st_size > 10_000 and f"]({name})" in report
 

@@ -41,18 +41,18 @@ from occupose.pose import (
     add_reach_term,
     default_stages,
 )
-from occupose.synth.generate import frames, person_observations
+from occupose.synth.generate import UPPER_BODY_PARTS, frames, person_observations
 from occupose.synth.motion import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
 NUM_FRAMES = 90  # 3 s at 30 fps: the FAIL rule's 2 s window after its 1 s grace period
 MAX_POINTS = 1000
 ARMS = [JOINT_INDEX[name] for name in ("left_elbow", "left_wrist", "right_elbow", "right_wrist")]
-def _scene(name: str, upper_body_only: bool = False):
+def _scene(name: str, parts=None):
     """(ground-truth joints (T, 15, 3) metres, [Observation] * T) of person 1 on procedural motion."""
     scenario = build_scenario(name, use_mocap=False)
     return scenario.people[0].joints[:NUM_FRAMES], person_observations(
-        scenario, NUM_FRAMES, upper_body_only=upper_body_only, max_points=MAX_POINTS)
+        scenario, NUM_FRAMES, parts=parts, max_points=MAX_POINTS)
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +65,7 @@ def walk():
 def top_view():
     """The first 3 s of procedural top_view_arms (waving the right arm under a ceiling camera),
     upper-body pixels only."""
-    return _scene("top_view_arms", upper_body_only=True)
+    return _scene("top_view_arms", parts=UPPER_BODY_PARTS)
 
 
 def _estimator(model_name, gt, filter_name, particles, seed, **options):

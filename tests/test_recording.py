@@ -137,14 +137,18 @@ def test_label_images_round_trip_and_errors(tmp_path, rng):
     recording = Recording(tmp_path / "synth")
     np.testing.assert_array_equal(recording.label(0, "cam0", "person"), person)
     np.testing.assert_array_equal(recording.label(0, "cam0", "part"), part)
+    assert recording.has_labels("person") and recording.has_labels("part")
     with pytest.raises(ValueError, match="unknown label kind 'skin'; valid: person, part"):
         recording.label(0, "cam0", "skin")
+    with pytest.raises(ValueError, match="unknown label kind 'skin'"):
+        recording.has_labels("skin")
     with RecordingWriter(tmp_path / "plain", [camera], fps=30) as writer:
         writer.write_frame({"cam0": np.zeros((6, 8), np.uint16)})
         with pytest.raises(ValueError, match="label image 'part' for camera 'cam0' must be .* uint8"):
             writer.write_frame({"cam0": np.zeros((6, 8), np.uint16)}, labels={"cam0": {"part": part.astype(np.int32)}})
     with pytest.raises(RecordingError, match="has no 'person' label images"):
         Recording(tmp_path / "plain").label(0, "cam0", "person")
+    assert not Recording(tmp_path / "plain").has_labels("part")
 
 
 def test_writer_with_exception_leaves_no_header(tmp_path, rng):

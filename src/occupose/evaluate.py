@@ -45,7 +45,8 @@ import numpy as np
 
 from occupose.joints import JOINTS
 from occupose.metrics import (
-    Score, TableRow, frame_errors, joint_errors, markdown_table, match_tracks, score, write_tracks_csv,
+    ARM_PARTS, MIN_ARM_POINTS, Score, TableRow, arm_epsilons, frame_errors, joint_errors, markdown_table, match_tracks, score,
+    write_tracks_csv,
 )
 
 #: Methods compared when none are named.
@@ -58,6 +59,9 @@ PARTLY_HIDDEN = 0.25
 MOSTLY_HIDDEN = 0.75
 #: FAIL threshold drawn in the error plots, cm (metrics.is_fail).
 FAIL_THRESHOLD_CM = 25.0
+#: Arm points per person and frame that the arm error (metrics.arm_epsilons) measures at
+#: most, an even subsample of those seen.
+ARM_SAMPLE = 400
 #: Name of the file beside a rendered recording that records how it was rendered.
 RENDER_INFO = "render.json"
 
@@ -77,6 +81,9 @@ class RunResult:
         track reports (NaN where the person is not counted or has no estimate)
     fps : frames per second of tracking, start-up excluded
     seconds : seconds per stage, ``total`` and ``startup`` (TrackingResult.seconds)
+    arm_epsilon, truth_arm_epsilon : (T, P) float64, metres, or None for a recording
+        without part labels: the second paper's arm error (metrics.arm_epsilons) of each
+        person's matched track (NaN without an estimate) and of its ground truth
     """
 
     scenario: str
@@ -87,6 +94,8 @@ class RunResult:
     frame_errors: np.ndarray
     fps: float
     seconds: dict[str, float] = field(default_factory=dict)
+    arm_epsilon: np.ndarray | None = None
+    truth_arm_epsilon: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -161,6 +170,39 @@ def render_recording(scenario: str, out: Path, frames: int | None, procedural: b
     return out
 
 
+def arm_points(rec, person_ids: Sequence[int], max_points: int = ARM_SAMPLE) -> list[list[np.ndarray]]:
+    """[person][frame] (N, 3) float64, world metres: the pixels of each person's arms
+    (metrics.ARM_PARTS in the recording's part labels) that every camera measured,
+    back-projected; at most ``max_points`` per frame, an even subsample. The recording
+    must have person and part labels (Recording.has_labels)."""
+    from occupose.camera import points_from_depth
+
+    out: list[list[np.ndarray]] = [[] for _ in person_ids]
+    for index in range(rec.num_frames):
+        seen: list[list[np.ndarray]] = [[] for _ in person_ids]
+        for camera in rec.cameras:
+            depth = rec.depth_raw(index, camera.name)
+            arms = np.isin(rec.label(index, camera.name, "part"), ARM_PARTS)
+            person = rec.label(index, camera.name, "person")
+            for p, pid in enumerate(person_ids):
+                seen[p].append(points_from_depth(np.where(arms & (person == pid), depth, 0), camera)[0])
+        for p, pieces in enumerate(seen):
+            points = np.concatenate(pieces)
+            out[p].append(points[:: -(-len(points) // max_points)] if len(points) > max_points else points)
+    return out
+
+
+def _tracked_arm_epsilons(gt_joints: np.ndarray, arms: list[list[np.ndarray]],
+                          tracks: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(T, P) arm error (metrics.arm_epsilons) of each person's matched track (NaN
+    without one) and of its ground-truth skeleton, metres."""
+    tracked = np.full(gt_joints.shape[:2], np.nan)
+    for track_id, person in match_tracks(gt_joints, tracks).items():
+        tracked[:, person] = arm_epsilons(arms[person], tracks[track_id])
+    truth = np.stack([arm_epsilons(arms[p], gt_joints[:, p]) for p in range(gt_joints.shape[1])], axis=1)
+    return tracked, truth.reshape(gt_joints.shape[:2])
+
+
 def _tracked_frame_errors(gt_joints: np.ndarray, gt_visible: np.ndarray, tracks: dict[int, np.ndarray]) -> np.ndarray:
     """(T, P) D_t of each person against its matched track, as metrics.score counts it
     (joints the track reports, frames where some joint of the person is visible)."""
@@ -192,11 +234,15 @@ def run_method(recording: Path, scenario: str, method: str, seed: int, out: Path
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=list) + "\n")
     gt = rec.groundtruth()
     joints = {tid: track[0] for tid, track in result.tracks.items()}
+    arms = None
+    if rec.has_labels("part") and rec.has_labels("person"):
+        arms = _tracked_arm_epsilons(gt.joints, arm_points(rec, gt.person_ids), joints)
     return RunResult(
         scenario=scenario, method=method, seed=seed,
         score=score(gt.joints, gt.visible, joints, rec.fps), person_ids=tuple(gt.person_ids),
         frame_errors=_tracked_frame_errors(gt.joints, gt.visible, joints),
         fps=float(result.fps), seconds=dict(result.seconds),
+        arm_epsilon=None if arms is None else arms[0], truth_arm_epsilon=None if arms is None else arms[1],
     )
 
 
@@ -368,11 +414,12 @@ def _seconds_keys(runs: Sequence[RunResult]) -> list[str]:
 
 def results_table(runs: Sequence[RunResult]) -> list[dict[str, object]]:
     """One dict per scenario, method, run (seed) and ground-truth person: Table I over all
-    joints and over visible joints, identity switches, frames/s, seconds per stage."""
+    joints and over visible joints, the arm error of the track and of the ground truth,
+    identity switches, frames/s, seconds per stage."""
     stage_keys = _seconds_keys(runs)
     rows = []
     for run in runs:
-        for person, pid in zip(run.score.persons, run.person_ids):
+        for index, (person, pid) in enumerate(zip(run.score.persons, run.person_ids)):
             row: dict[str, object] = {"scenario": run.scenario, "method": run.method, "seed": run.seed,
                                       "person": pid, "track": "" if person.track is None else person.track}
             for prefix, table in (("", person.all_joints), ("visible_", person.visible_joints)):
@@ -381,11 +428,24 @@ def results_table(runs: Sequence[RunResult]) -> list[dict[str, object]]:
                         f"{prefix}under20": table.under20, f"{prefix}over20": table.over20,
                         f"{prefix}fail": int(table.fail), f"{prefix}frames": table.frames,
                         f"{prefix}coverage": table.coverage}
+            row |= dict(zip(("arm_eps_cm", "truth_arm_eps_cm"), _arm_errors_cm(run, index)))
             row |= {"identity_switches": person.identity_switches,
                     "unmatched_tracks": len(run.score.unmatched_tracks), "fps": run.fps}
             row |= {f"seconds_{k}": run.seconds.get(k, math.nan) for k in stage_keys}
             rows.append(row)
     return rows
+
+
+def _arm_errors_cm(run: RunResult, person: int) -> tuple[float, float]:
+    """Mean arm error (metrics.arm_epsilons) over the frames that have one, cm, of the
+    person's track and of its ground truth; NaN without one (or without part labels)."""
+    if run.arm_epsilon is None:
+        return math.nan, math.nan
+    means = []
+    for values in (run.arm_epsilon[:, person], run.truth_arm_epsilon[:, person]):
+        finite = values[np.isfinite(values)]
+        means.append(100.0 * float(finite.mean()) if finite.size else math.nan)
+    return means[0], means[1]
 
 
 def write_results_csv(path: str | os.PathLike, runs: Sequence[RunResult]) -> Path:
@@ -444,6 +504,32 @@ def _markdown(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])
 
 
+def _arm_section(runs: Sequence[RunResult], methods: list[str]) -> list[str]:
+    """The report's lines on the second paper's arm error (none without part labels)."""
+    rows = []
+    for label, by_method in _groups(runs).items():
+        means = {m: [_arm_errors_cm(r, i) for r, i in items] for m, items in by_method.items()}
+        if all(math.isnan(v) for pairs in means.values() for pair in pairs for v in pair):
+            continue
+        tracked = {m: float(np.nanmean([a for a, _ in pairs])) if any(not math.isnan(a) for a, _ in pairs)
+                   else math.nan for m, pairs in means.items()}
+        finite = [v for v in tracked.values() if not math.isnan(v)]
+        best = min(finite) if len(finite) > 1 else math.nan
+        truth = next(t for pairs in means.values() for _, t in pairs)
+        rows.append([label, *(f"**{_number(tracked[m])}**" if round(tracked.get(m, math.nan), 2) == round(best, 2)
+                              else _number(tracked.get(m, math.nan)) for m in methods), _number(truth)])
+    if not rows:
+        return []
+    return ["## Arm error: the second paper's epsilon [cm]", "",
+            "Mean over the frames with at least "
+            f"{MIN_ARM_POINTS} arm points seen and an estimate, and over the runs, of the mean distance from "
+            "the person's arm points (upper arms, forearms, hands in the part labels; every camera) to the "
+            "nearest arm bone of the skeleton (occupose.metrics). Lowest per sequence in bold. The points lie "
+            "on the surface, so the ground truth's skeleton has an epsilon too (last column): what a perfect "
+            "skeleton scores.", "",
+            _markdown(["sequence", *methods, "ground truth"], rows), ""]
+
+
 def report_markdown(runs: Sequence[RunResult], plots: Sequence[Path] = (), root: Path | None = None, *,
                     jobs: int | None = None, frames: dict[str, int] | None = None, procedural: bool = False) -> str:
     """The evaluation report (markdown): Table I over all joints (best value of each column
@@ -483,6 +569,7 @@ def report_markdown(runs: Sequence[RunResult], plots: Sequence[Path] = (), root:
     lines += ["## Identities", "", "Mean over the runs of the person's identity switches and of the "
               "tracks matched to no person.", "",
               _markdown(["sequence", "method", "identity switches", "unmatched tracks"], switches), ""]
+    lines += _arm_section(runs, methods)
     joints = per_joint_table(runs)
     joint_rows = []
     for joint, values in joints.items():

@@ -24,6 +24,14 @@ table row (Table I)
     ``>20`` add up to 100 %. A missed frame counts as an error above every bound (in
     ``>20``, in none of the others). ``coverage`` is the percentage of counted frames
     that are estimated.
+arm error ``epsilon`` (the second paper's)
+    Mean distance from a person's observed arm points (pixels of its upper arms,
+    forearms and hands: the renderer's part image) to the nearest arm bone
+    (shoulder-elbow, elbow-wrist) of a skeleton. The paper measures them "to the
+    estimated model state"; a skeleton is what every method reports, and the arms' bones
+    alone do not credit an arm point that the trunk would explain. The points lie on the
+    surface, a limb's radius from its bone and a hand's length beyond the wrist, so the
+    ground-truth skeleton has an epsilon too: the floor any estimate is read against.
 FAIL
     The rolling mean of ``D_t`` over a trailing window of ``window_s`` seconds
     (``round(window_s * fps)`` frames, the current frame included; windows reaching
@@ -51,7 +59,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from scipy.optimize import linear_sum_assignment
 
-from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS
+from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS, PART_INDEX
 
 #: Error a missed frame counts as in the FAIL rule's rolling mean, metres.
 MISSED_ERROR_M = 1.0
@@ -218,6 +226,59 @@ def per_joint_errors(errors: Any, joint_names: Sequence[str]) -> dict[str, float
         )
     means = _nanmean(errors, axis=0) * 100.0
     return {str(name): float(value) for name, value in zip(joint_names, means)}
+
+
+# --------------------------------------------------------------------------- arm error
+
+
+#: Body parts (occupose.joints.PARTS labels) whose points the arm error measures.
+ARM_PARTS: tuple[int, ...] = tuple(PART_INDEX[f"{side}_{part}"] for side in ("left", "right")
+                                   for part in ("upper_arm", "forearm", "hand"))
+#: Bones (joint index pairs) the arm points are measured to.
+ARM_BONES: tuple[tuple[int, int], ...] = tuple(
+    (JOINT_INDEX[f"{side}_{a}"], JOINT_INDEX[f"{side}_{b}"])
+    for side in ("left", "right") for a, b in (("shoulder", "elbow"), ("elbow", "wrist")))
+#: A frame with fewer arm points than this has no arm error (an arm seen by a few pixels
+#: at the edge of a hand says little).
+MIN_ARM_POINTS = 20
+
+
+def segment_distances(points: Any, starts: Any, ends: Any) -> np.ndarray:
+    """Distance from each point to the nearest of S segments.
+
+    points : (N, 3) float, metres; starts, ends : (S, 3) float, metres, S >= 1
+    Returns (N,) float64, metres.
+    """
+    points = _float_array(points, "points", (None, 3))
+    starts = _float_array(starts, "starts", (None, 3))
+    ends = _float_array(ends, "ends", (starts.shape[0], 3))
+    if starts.shape[0] == 0:
+        raise ValueError("segment_distances needs at least one segment")
+    axis = ends - starts                                          # (S, 3)
+    length2 = np.maximum(np.einsum("sk,sk->s", axis, axis), 1e-18)
+    offset = points[:, None, :] - starts[None]                    # (N, S, 3)
+    along = np.clip(np.einsum("nsk,sk->ns", offset, axis) / length2, 0.0, 1.0)
+    gap = offset - along[..., None] * axis[None]
+    return np.sqrt(np.einsum("nsk,nsk->ns", gap, gap).min(axis=1))
+
+
+def arm_epsilons(arm_points: Sequence[Any], joints: Any) -> np.ndarray:
+    """The second paper's arm error of every frame (module docstring).
+
+    arm_points : T arrays (N_t, 3), metres, world: the person's observed arm points
+    joints : (T, 15, 3) float, metres: the skeleton measured (NaN where not reported)
+    Returns (T,) float64, metres; NaN where a frame has fewer than MIN_ARM_POINTS points
+    or the skeleton misses an arm joint.
+    """
+    joints = _float_array(joints, "joints", (len(arm_points), NUM_JOINTS, 3))
+    starts = np.array([a for a, _ in ARM_BONES])
+    ends = np.array([b for _, b in ARM_BONES])
+    out = np.full(len(arm_points), np.nan)
+    for t, points in enumerate(arm_points):
+        skeleton = joints[t]
+        if len(points) >= MIN_ARM_POINTS and np.all(np.isfinite(skeleton[np.r_[starts, ends]])):
+            out[t] = float(segment_distances(points, skeleton[starts], skeleton[ends]).mean())
+    return out
 
 
 # --------------------------------------------------------------------------- FAIL rule

@@ -386,6 +386,12 @@ class Recording:
             raise RecordingError(f"{file.parent}: this recording has no {kind!r} label images (only synthetic ones do)")
         return _read_png(file, "L", (camera.height, camera.width), f"an 8-bit {kind} label")
 
+    def has_labels(self, kind: str) -> bool:
+        """Whether every camera has ``kind`` label images (LABEL_KINDS; synthetic recordings)."""
+        if kind not in LABEL_KINDS:
+            raise ValueError(f"unknown label kind {kind!r}; valid: {', '.join(LABEL_KINDS)}")
+        return all((self.path / c.name / kind).is_dir() for c in self.cameras)
+
     def frame(self, index: int) -> Frame:
         """Frame ``index``: depth in float32 metres for every camera, colour where there is any."""
         index = self._check_index(index)
