@@ -26,6 +26,7 @@ from occupose.tracker import (
     INIT_FRAMES,
     LATER_SPEED,
     METHODS,
+    MIN_FILL,
     SHAPE_FRAMES,
     STATURE_CHANGE,
     STATURE_FRAMES,
@@ -37,6 +38,7 @@ from occupose.tracker import (
     WALKING_SPEED,
     Tracker,
     _Person,
+    silhouette_fill,
     track_frames,
 )
 
@@ -154,19 +156,22 @@ def test_overlapping_the_grid_with_the_pose_stage_tracks_alike(walk):
     """The grid update of frame t + 1 runs during stage 3 of frame t. Without hold masks the
     grid does not depend on the poses, and the tracks are the same to the bit; with them
     (frame t + 1's from the bodies of frame t - 1) the run differs and tracks the person as
-    well: the same person, under 8 cm (measured 5.3 cm without, 6.5 with the overlap; the
-    two runs part like two seeds do, by 0.4-6 cm on these 40 frames, either way)."""
+    well: the same person, under 8 cm over seeds 0-3 (measured 6.6 cm without, 7.3 with the
+    overlap; one seed's two runs part like two seeds do, by 0.3-4 cm on these 40 frames,
+    either way)."""
     scenario, rendered = walk
     gt = np.stack([f.joints[0] for f in rendered[:40]])
-    for hold in (False, True):
-        results = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0, hold_people=hold),
-                                rendered[:40], 40, overlap=o) for o in (False, True)]
-        assert [list(r.tracks) for r in results] == [[1], [1]]
-        errors = [np.nanmean(frame_errors(joint_errors(gt, r.tracks[1][0]))) for r in results]
-        if hold:
-            assert max(errors) < 0.08, errors
-        else:
-            assert np.array_equal(results[0].tracks[1][0], results[1].tracks[1][0], equal_nan=True)
+    results = [track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0, hold_people=False),
+                            rendered[:40], 40, overlap=o) for o in (False, True)]
+    assert np.array_equal(results[0].tracks[1][0], results[1].tracks[1][0], equal_nan=True)
+    errors = {}
+    for overlap in (False, True):
+        for seed in range(4):
+            result = track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=seed, hold_people=True),
+                                  rendered[:40], 40, overlap=overlap)
+            assert list(result.tracks) == [1]
+            errors.setdefault(overlap, []).append(np.nanmean(frame_errors(joint_errors(gt, result.tracks[1][0]))))
+    assert max(np.mean(e) for e in errors.values()) < 0.08, errors
 
 
 def test_same_seed_same_tracks(walk):
@@ -486,6 +491,28 @@ def test_a_blob_whose_own_points_stay_below_a_seated_head_does_not_start(trackin
     assert len(chair.points) > 1000
     assert not _tries_to_start(tracking, monkeypatch, chair, 1.5)
     assert _tries_to_start(tracking, monkeypatch, observation, 1.5)  # the whole body does
+
+
+def test_silhouette_fill_of_solid_and_scattered_pixels():
+    width = 160
+    v, u = np.meshgrid(np.arange(20, 110), np.arange(60, 90), indexing="ij")
+    solid = np.sort((v * width + u).reshape(-1))
+    assert silhouette_fill(solid, width) == pytest.approx(1.0, abs=0.01)
+    scattered = np.sort(np.random.default_rng(0).choice(solid, solid.size // 20, replace=False))
+    assert silhouette_fill(scattered, width) == pytest.approx(0.05, abs=0.01)
+    assert silhouette_fill(np.zeros(0, np.int64), width) == 0.0
+
+
+def test_a_blob_of_scattered_pixels_does_not_start(tracking, monkeypatch):
+    """A ghost: a wall's noisy readings, no longer overruled by a second camera whose line of
+    sight a person blocks, scattered over the image like every 25th pixel of a person's."""
+    observation = tracking[0]._previous[1]
+    ghost = GridObservation(99, {c: observation.pixels[c][::25] for c in observation.pixels},
+                            {c: observation.camera_points[c][::25] for c in observation.camera_points})
+    assert len(ghost.points) > 200 and ghost.points[:, 2].max() > 1.5
+    assert max(silhouette_fill(ghost.pixels[c], 640) for c in ghost.pixels) < MIN_FILL
+    assert not _tries_to_start(tracking, monkeypatch, ghost, 1.5)
+    assert _tries_to_start(tracking, monkeypatch, observation, 1.5)
 
 
 def test_points_far_from_the_predicted_body_are_left_out_of_the_likelihood(tracking):

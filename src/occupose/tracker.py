@@ -144,6 +144,15 @@ MIN_INIT_POINTS = 200
 #: points pooled (the grid extracts a newly moving body over a few frames, so the first
 #: frames' points fall short of the head).
 INIT_FRAMES = 5
+#: and some camera sees its pixels as a solid silhouette: they fill at least this share of
+#: the image box between the FILL_QUANTILES of their columns and of their rows
+#: (silhouette_fill). A person fills 0.55-0.8 of it (0.12 while cut by the image's edge); a
+#: wall's noisy readings that a second camera's line of sight no longer overrules, in the
+#: shadow a person casts from that camera, scatter over 0.01-0.08 of theirs and would
+#: start a ghost (two_cameras_occlusion: a person's shadow from the side camera sweeping
+#: the back wall, 300 of its pixels in the front camera over 0.7 x 1.3 m).
+MIN_FILL = 0.25
+FILL_QUANTILES = (5.0, 95.0)
 #: A person whose pixels come within this many pixels of the left, right or top image edge
 #: is not fully in view and does not start yet.
 BORDER_PX = 3
@@ -477,6 +486,20 @@ def joints_of(model: BodyModel, pose: np.ndarray) -> np.ndarray:
     return joints_from_poses(model, np.asarray(pose, float)[None])[0]
 
 
+def silhouette_fill(pixels: np.ndarray, width: int) -> float:
+    """Share of the image box between the FILL_QUANTILES of the pixels' columns and rows
+    that the pixels fill (0 for none).
+
+    pixels : (N,) int, flat indices ``v * width + u`` of one camera's pixels, distinct
+    """
+    if len(pixels) == 0:
+        return 0.0
+    rows, columns = np.divmod(np.asarray(pixels), width)
+    (u0, u1), (v0, v1) = np.percentile(columns, FILL_QUANTILES), np.percentile(rows, FILL_QUANTILES)
+    inside = (columns >= u0) & (columns <= u1) & (rows >= v0) & (rows <= v1)
+    return float(np.count_nonzero(inside) / ((np.floor(u1) - np.ceil(u0) + 1) * (np.floor(v1) - np.ceil(v0) + 1)))
+
+
 def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera) -> np.ndarray:
     """The headings of INIT_HEADINGS a person may start with, radians: those within 90
     degrees of where they walk (``velocity`` (2,) m/s, when faster than WALKING_SPEED),
@@ -689,7 +712,8 @@ class Tracker:
         """A new person from its blob, or None while the blob has not been person-like for
         INIT_FRAMES frames."""
         points = observation.points
-        if len(points) < MIN_INIT_POINTS or top_height(points[:, 2]) < MIN_INIT_TOP or self._at_border(observation):
+        if (len(points) < MIN_INIT_POINTS or top_height(points[:, 2]) < MIN_INIT_TOP or self._at_border(observation)
+                or max(silhouette_fill(observation.pixels[c.name], c.width) for c in self.cameras) < MIN_FILL):
             self._pending.pop(tid, None)
             return None
         centroid = self.blobs.states[tid].centroid[:2]
