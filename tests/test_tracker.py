@@ -524,11 +524,11 @@ def test_points_far_from_the_predicted_body_are_left_out_of_the_likelihood(track
     person, observation = tracker.people[1], tracker._previous[1]
     cam = tracker.cameras[0].name
     own = observation.pixels[cam]
-    # a carried box: pixels beside the person's, its points 0.55 .. 0.75 m in front of the
-    # pelvis, at the pelvis's height
+    # a carried box: pixels beside the person's, its points 0.65 .. 0.85 m in front of the
+    # pelvis (beyond the hand that swings forward), at the pelvis's height
     box = np.setdiff1d(np.arange(own.max() + 1, own.max() + 400, 2), own)
     heading = person.pose[person.model.dof_names.index("heading")]
-    ahead = np.linspace(0.55, 0.75, len(box))
+    ahead = np.linspace(0.65, 0.85, len(box))
     box_points = person.pose[:3] + np.column_stack([ahead * np.cos(heading), ahead * np.sin(heading),
                                                     np.linspace(-0.1, 0.1, len(box))])
     carried = GridObservation(1, {cam: np.concatenate([own, box])},
