@@ -154,6 +154,8 @@ def _plot(rows: list[dict]) -> None:
     panels = (("mean_cm", "mean joint error [cm]"), ("arm_cm", "arm joints' error [cm]"),
               ("eps_cm", "arm error epsilon [cm] (dotted: ground truth's)"))
     fig, axes = plt.subplots(len(panels), len(SCENES), figsize=(11, 11), squeeze=False)
+    times = [r["ms_per_frame"] for r in rows]
+    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200) if min(times) / 2 <= t <= 2 * max(times)]
     for column, (scene, model_name, _) in enumerate(SCENES):
         for row_index, (key, label) in enumerate(panels):
             ax = axes[row_index, column]
@@ -169,7 +171,7 @@ def _plot(rows: list[dict]) -> None:
             motion = next(r["motion"] for r in rows if r["scene"] == scene)
             ax.set_title(f"{scene} ({model_name} model, {motion} motion)", fontsize=10)
             ax.set_xscale("log")
-            ax.set_xticks([5, 10, 20, 50, 100, 200])
+            ax.set_xticks(ticks)
             ax.xaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
             ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
             ax.set_xlabel("time per frame [ms] (labels: likelihood evaluations)")
