@@ -147,14 +147,19 @@ def test_walking_costs_facing_away_from_the_way_walked_on_the_heading_part(walk)
     assert np.all(np.delete(walking - free, torso, axis=1) == 0.0)
 
 
-def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
+def _floor_problems(walk, frame: int = 10):
+    """(model sized to the walker, PoseProblem with the floor at z = 0, the same without a
+    floor, the walker's fitted pose at ``frame``), both problems on that frame's observation."""
     gt, observations = walk
     model = body_model("full", dims=dims_from_joints(gt))
-    problem = PoseProblem(model)
-    free = PoseProblem(model, floor=None)
+    problem, free = PoseProblem(model), PoseProblem(model, floor=None)
     for p in (problem, free):
-        p.set_observation(observations[10])
-    pose = pose_from_joints(model, gt[10])
+        p.set_observation(observations[frame])
+    return model, problem, free, pose_from_joints(model, gt[frame])
+
+
+def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
+    model, problem, free, pose = _floor_problems(walk)
     sunk = pose.copy()
     sunk[model.dof("z")] -= 0.2
     values, without = problem.log_likelihood(np.array([pose, sunk])), free.log_likelihood(np.array([pose, sunk]))
@@ -171,15 +176,11 @@ def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
 
 
 def test_an_ankle_raised_beyond_a_step_costs_its_shin(walk):
-    """The feet term: the walker's right leg lifted forwards (hip flexed 1.6 rad, knee 0.2), its ankle
-    more than 0.5 m above the floor, costs the right shin FOOT_COST per metre above
-    FOOT_REACH and nothing else; walking (a foot swinging 0.21 m up), nothing; a model without legs, nothing."""
-    gt, observations = walk
-    model = body_model("full", dims=dims_from_joints(gt))
-    problem, free = PoseProblem(model), PoseProblem(model, floor=None)
-    for p in (problem, free):
-        p.set_observation(observations[10])
-    pose = pose_from_joints(model, gt[10])
+    """The feet term: the walker's right leg lifted forwards (hip flexed 1.6 rad, knee 0.2),
+    its ankle more than 0.5 m above the floor, costs the right shin FOOT_COST per metre above
+    FOOT_REACH and nothing else; walking (a foot swinging 0.21 m up), nothing; a model
+    without legs, nothing."""
+    model, problem, free, pose = _floor_problems(walk)
     lifted = pose.copy()
     lifted[[model.dof("right_hip_flex"), model.dof("right_knee")]] = 1.6, 0.2
     poses = np.array([pose, lifted])
@@ -201,12 +202,8 @@ def test_a_body_reaching_higher_than_it_can_standing_costs_even_with_the_legs_hi
     REACH_SLACK, also when its legs are hidden (they ride along with the pelvis; the foot
     it swings, lifted beyond a step, costs its shin too while seen: the feet term); standing,
     nothing. The upper body: its head's top above its stature."""
-    gt, observations = walk
-    model = body_model("full", dims=dims_from_joints(gt))
-    problem, free = PoseProblem(model), PoseProblem(model, floor=None)
-    for p in (problem, free):
-        p.set_observation(observations[10])
-    pose = pose_from_joints(model, gt[10])
+    model, problem, free, pose = _floor_problems(walk)
+    observations = walk[1]
     lifted = pose.copy()
     lifted[model.dof("z")] += 0.2
     torso = model.part_names.index("torso")
