@@ -178,8 +178,8 @@ def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
 def test_an_ankle_raised_beyond_a_step_costs_its_shin(walk):
     """The feet term: the walker's right leg lifted forwards (hip flexed 1.6 rad, knee 0.2),
     its ankle more than 0.5 m above the floor, costs the right shin FOOT_COST per metre above
-    FOOT_REACH and nothing else; walking (a foot swinging 0.21 m up), nothing; a model
-    without legs, nothing."""
+    FOOT_REACH and nothing else, measured from the floor's height; walking (a foot swinging
+    0.21 m up), nothing; a model without legs, nothing."""
     model, problem, free, pose = _floor_problems(walk)
     lifted = pose.copy()
     lifted[[model.dof("right_hip_flex"), model.dof("right_knee")]] = 1.6, 0.2
@@ -190,6 +190,10 @@ def test_an_ankle_raised_beyond_a_step_costs_its_shin(walk):
     expected = np.zeros((2, len(model.part_names)))
     expected[1, model.part_names.index("right_shin")] = FOOT_COST * (ankles[1, 1] - FOOT_REACH)
     np.testing.assert_allclose(cost, expected, atol=1e-6)  # joints and capsule ends agree to ~1e-7 m
+    # the floor 0.1 m higher: the same ankle is 0.1 m less above it
+    raised = np.zeros((2, len(model.part_names)))
+    add_feet_term(model, capsules_from_poses(model, poses)[1], 0.1, raised)
+    np.testing.assert_allclose(-raised, expected - FOOT_COST * 0.1 * (expected > 0), atol=1e-6)
     upper = body_model("upper")
     out = np.zeros((1, len(upper.part_names)))
     add_feet_term(upper, capsules_from_poses(upper, standing_pose(upper, (0.0, 0.0))[None])[1], -1.0, out)

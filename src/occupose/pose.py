@@ -153,19 +153,24 @@ def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float,
 
 def add_feet_term(model: BodyModel, b: np.ndarray, floor: float, out: np.ndarray) -> None:
     """Add the feet term to per-part log-likelihoods ``out`` (P, K), in place, from the
-    capsules' bottom ends b (P, C, 3), world metres: each shin of ``model`` whose ankle end
-    is more than FOOT_REACH above ``floor`` (metres) costs its part FOOT_COST nats per
-    metre beyond (a model without shins: nothing)."""
-    shins = _shins(model)
+    capsules' ends b (P, C, 3), world metres (a shin's end b is its ankle): each shin of
+    ``model`` whose ankle is more than FOOT_REACH above ``floor`` (metres) costs its part
+    FOOT_COST nats per metre beyond (a model without shins: nothing)."""
+    shins, parts = _shins(model)
     if len(shins):
         raised = np.maximum(b[:, shins, 2] - floor - FOOT_REACH, 0.0)
-        out -= FOOT_COST * (raised @ _part_matrix(model)[shins])
+        out -= FOOT_COST * (raised @ parts)
 
 
 @functools.lru_cache(maxsize=64)
-def _shins(model: BodyModel) -> np.ndarray:
-    """(S,) int64: the capsules of ``model``'s shin parts (their ends b are the ankles)."""
-    return np.array([c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("shin")], np.int64)
+def _shins(model: BodyModel) -> tuple[np.ndarray, np.ndarray]:
+    """(the capsules of ``model``'s shin parts (S,) int64, their rows of :func:`_part_matrix`
+    (S, K) float64), read-only (cached: the likelihood is evaluated many times a frame)."""
+    shins = np.array([c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("shin")], np.int64)
+    parts = _part_matrix(model)[shins]
+    for array in (shins, parts):
+        array.setflags(write=False)
+    return shins, parts
 
 
 @functools.lru_cache(maxsize=64)
