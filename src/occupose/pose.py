@@ -14,7 +14,7 @@ import numpy as np
 
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
 from occupose.filters import apply_limits, make_filter
-from occupose.likelihood import Observation, make_likelihood
+from occupose.likelihood import Observation, make_likelihood, point_distances
 from occupose.proposals import limb_proposals, mirrored_legs
 
 
@@ -47,6 +47,17 @@ REACH_COST = 50.0
 #: (moved_chair).
 FOOT_REACH = 0.30
 FOOT_COST = 20.0
+#: The hanging-arm term (see PoseProblem.resting): an arm of a model with legs that has
+#: fewer than REST_POINTS of the observed points nearest to its capsules under the last
+#: estimate costs its upper arm REST_COST * (1 + cos) / 2 nats, the cosine of the angle
+#: between the upper arm (shoulder to elbow) and the vertical pointing up: 0 hanging,
+#: REST_COST raised. An arm the camera does not see (the far arm of a person seen side-on,
+#: behind the body) costs nothing in the depth terms anywhere behind the body and drifted
+#: there (two_people_crossing, the first person's arm error 9.8 cm against apf's 7.8); a
+#: seen arm's points outweigh the term. Models without legs (seen from above) are left
+#: out: the top views were not evaluated with it.
+REST_POINTS = 15
+REST_COST = 1.0
 
 
 class PoseProblem:
@@ -105,6 +116,9 @@ class PoseProblem:
         #: the tracker clears it until it has measured the stature again over the person's
         #: first second upright (the start's may fall short of the head under a ceiling camera).
         self.stature_known = True
+        #: (A,) int64: the upper arms' capsules under the hanging-arm term this frame
+        #: (:func:`add_rest_term`); set per frame by PoseEstimator (:func:`unseen_arms`).
+        self.resting = np.zeros(0, np.int64)
         #: The index of the model's heading DOF, or None for a model without one.
         self.heading_dof = model.dof_names.index("heading") if "heading" in model.dof_names else None
         self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self.heading_dof in g.dofs), None)
@@ -135,6 +149,7 @@ class PoseProblem:
             add_floor_term(self.model, a, b, self.floor, out)
             add_reach_term(self.model, a, b, self.floor, out, stature_known=self.stature_known)
             add_feet_term(self.model, b, self.floor, out)
+        add_rest_term(self.model, a, b, self.resting, out)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
@@ -160,6 +175,46 @@ def add_feet_term(model: BodyModel, b: np.ndarray, floor: float, out: np.ndarray
     if len(shins):
         raised = np.maximum(b[:, shins, 2] - floor - FOOT_REACH, 0.0)
         out -= FOOT_COST * (raised @ parts)
+
+
+def add_rest_term(model: BodyModel, a: np.ndarray, b: np.ndarray, capsules: np.ndarray, out: np.ndarray) -> None:
+    """Add the hanging-arm term to per-part log-likelihoods ``out`` (P, K), in place: each
+    capsule of ``capsules`` (upper arms, indices into the model's capsules; ends a, b
+    (P, C, 3), world metres) costs its part REST_COST * (1 + cos) / 2 nats, the cosine of
+    its axis (a to b) with the vertical pointing up."""
+    for c in capsules:
+        axis = b[:, c] - a[:, c]
+        up = axis[:, 2] / np.maximum(np.linalg.norm(axis, axis=1), 1e-9)
+        out[:, model.capsule_part[c]] -= REST_COST * 0.5 * (1.0 + up)
+
+
+def unseen_arms(model: BodyModel, pose: np.ndarray, observation: Observation,
+                min_points: int = REST_POINTS) -> np.ndarray:
+    """(A,) int64: the upper-arm capsules of ``model``'s arms (upper arm and forearm) that
+    fewer than ``min_points`` of ``observation``'s points are nearest to under ``pose``
+    (D,); none for a model without legs or arms."""
+    arms = _arms(model)
+    if not len(arms):
+        return np.zeros(0, np.int64)
+    a, b = capsules_from_poses(model, np.asarray(pose, float)[None])
+    _, nearest = point_distances(a, b, model.capsule_radii, observation)
+    counts = np.bincount(model.capsule_part[nearest[0]], minlength=len(model.part_names))
+    return np.array([upper for upper, parts in arms if counts[parts].sum() < min_points], np.int64)
+
+
+@functools.lru_cache(maxsize=64)
+def _arms(model: BodyModel) -> tuple[tuple[int, np.ndarray], ...]:
+    """((the upper arm's capsule, its arm's parts (2,) int64), ...) per arm of a model with
+    legs (cached); empty for a model without legs or arms."""
+    names = model.part_names
+    if "left_thigh" not in names or "left_upper_arm" not in names:
+        return ()
+    arms = []
+    for side in ("left", "right"):
+        parts = np.array([names.index(f"{side}_upper_arm"), names.index(f"{side}_forearm")], np.int64)
+        parts.setflags(write=False)
+        arms.append((int(np.flatnonzero(model.capsule_part == parts[0])[0]), parts))
+    return tuple(arms)
 
 
 @functools.lru_cache(maxsize=64)
@@ -279,7 +334,9 @@ class PoseEstimator:
     proposals : share of the particles whose arm or leg tries where the points unexplained
     by the last estimate suggest, per limb (:func:`occupose.proposals.limb_proposals`), and
     whose leg tries the other leg's angles for a still person with bent legs
-    (:func:`occupose.proposals.mirrored_legs`; 0 = none);
+    (:func:`occupose.proposals.mirrored_legs`; 0 = none); before each step the arms with
+    no points of their own under the last estimate are put under the hanging-arm term
+    (:func:`unseen_arms`, :attr:`PoseProblem.resting`);
     filter_options : e.g. ``num_layers``
     """
 
@@ -328,6 +385,8 @@ class PoseEstimator:
                 drift[~active] = 0.0
             self.filter.particles = self.filter.particles + drift
             self._previous = current.copy()
+        if current is not None:
+            self.problem.resting = unseen_arms(self.problem.model, current, observation)
         if self.proposals > 0 and current is not None:
             self._propose(current, observation, active)
         return self.filter.step(active=active, diffusion_scale=diffusion_scale)
