@@ -598,6 +598,35 @@ def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])
 
 
+@pytest.mark.parametrize("speed", [1.2, 0.3])
+def test_a_person_carried_out_of_sight_at_a_walk_stands_its_legs(speed):
+    """Carried at a walker's speed (above WALK_FROM), the legs' DOFs, and their occlusion
+    memory, take the standing pose's (the middle of a gait cycle), the trunk, head and arms
+    kept; coming back, the particles follow. Carried standing, nothing but the root's x, y
+    moves."""
+    model = body_model("full")
+    person = _Person(model, METHODS["ours"], 30.0, np.random.default_rng(0))
+    stride = standing_pose(model, (0.0, 0.0), 0.0)
+    for name, angle in (("left_hip_flex", 0.4), ("right_hip_flex", -0.3), ("right_knee", 0.6),
+                        ("left_shoulder_flex", -0.3), ("right_elbow", 0.5), ("trunk_lean", 0.1)):
+        stride[model.dof(name)] = angle
+    person.estimator.initialise(stride, 0.0)
+    person.pose, person.centroid = stride.copy(), np.array([0.0, 0.0, 1.0])
+    person.occlusion.memory = stride.copy()
+    person.path = [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY_FRAMES)]
+    person.carry()
+    legs = np.array([n.startswith(("left_hip", "left_knee", "right_hip", "right_knee")) for n in model.dof_names])
+    assert legs.sum() == 8 and person.walked_on == (speed > WALK_FROM)
+    rest = standing_pose(model) if person.walked_on else stride
+    np.testing.assert_allclose(person.pose[legs], rest[legs])
+    np.testing.assert_allclose(person.occlusion.memory[legs], rest[legs])
+    np.testing.assert_allclose(person.pose[2:][~legs[2:]], stride[2:][~legs[2:]])  # z, heading, trunk, head, arms
+    person.come_back(np.array([0.5, 0.0, 1.0]))
+    np.testing.assert_allclose(person.estimator.filter.particles[:, legs],
+                               np.broadcast_to(rest[legs], (len(person.estimator.filter.particles), 8)), atol=1e-12)
+    np.testing.assert_allclose(person.estimator.filter.estimate, person.pose, atol=1e-12)
+
+
 def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view():
     """The estimates of a person walking into occlusion stall at the cabinet's edge: the
     carry takes its step from the last estimates with every part in view (while they are

@@ -56,6 +56,7 @@ from occupose.body import (
     dims_from_observation,
     joints_from_poses,
     pose_from_joints,
+    standing_pose,
 )
 from occupose.body.size import (
     TOP_BIAS,
@@ -233,6 +234,10 @@ REJOIN_M = 1.0
 #: A blob whose centroid is within this distance of a tracked person's pelvis does not
 #: start a new person (it split off that person's blob), metres (horizontal).
 START_CLEARANCE = 0.5
+#: The DOFs of the legs (by name): a person carried at a walker's speed out of sight stands
+#: (_Person.carry). The arms keep their last configuration: rested too, hanging, they fitted
+#: the arm pixels after the cabinet worse (epsilon 10.8 -> 12.3 cm, `ours`, 3 runs).
+LEG_DOFS = ("left_hip", "left_knee", "right_hip", "right_knee")
 
 
 def _model_for(cameras: Sequence[Camera]) -> str:
@@ -271,6 +276,8 @@ class _Person:
             parents, dofs = part_tree(model)  # under which furniture hides no part of it
             self.occlusion = OcclusionState(parents, dofs, model.num_dofs)
         self.joint_parts = joint_parts(model)
+        self.legs = np.array([n.startswith(LEG_DOFS) for n in model.dof_names])  # (D,) bool (carry)
+        self.stance = standing_pose(model)  # (D,) standing at rest, feet under the hips
         self.pose: np.ndarray | None = None
         self.centroid: np.ndarray | None = None  # (3,) its blob's centroid when last seen
         self.anchor = np.zeros(2)  # pelvis x, y minus its blob's centroid x, y at the last estimate
@@ -384,6 +391,7 @@ class _Person:
         self.problem.resize(model)
         self.estimator.shift(pose - self.pose)
         self.pose = pose
+        self.stance = standing_pose(model)
 
     def walking(self) -> tuple[float, float] | None:
         """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
@@ -436,12 +444,19 @@ class _Person:
     def carry(self) -> None:
         """A frame without an estimate (gone or suspended): the pose walks on at :meth:`step`;
         at a walker's speed (above WALK_FROM) it comes back where it was carried to
-        (:meth:`come_back`)."""
+        (:meth:`come_back`), and its legs (and their occlusion memory) stand, the feet under
+        the hips: a stride frozen while the walk goes on out of sight is a whole step off at
+        every other step (the ankles 0.67 m behind the cabinet of enter_exit_occlusion),
+        where the middle of a gait cycle is at most half a step off."""
         step = self.step()
         self.pose = self.pose.copy()
         self.pose[:2] += step
         self.lost = True
         self.walked_on = float(np.hypot(*step)) * self.fps > WALK_FROM
+        if self.walked_on:
+            self.pose[self.legs] = self.stance[self.legs]
+            if self.occlusion is not None:
+                self.occlusion.memory[self.legs] = self.stance[self.legs]
 
     def come_back(self, centroid: np.ndarray) -> None:
         """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
@@ -449,12 +464,14 @@ class _Person:
         (:meth:`carry`: the centroid of a body coming out from behind a cabinet lags at the
         cabinet's edge, whether its blob was kept or had gone). The particles are where the
         last estimate left them, not where the pose was carried since, so they are shifted
-        from the estimate. The paths are moved along (the jump onto the blob is no step of
-        the person's): the way it walked before goes on, so a person hidden again soon after
-        is carried on that way."""
+        from the estimate (the root's x, y, and the legs when they came to stand). The paths
+        are moved along (the jump onto the blob is no step of the person's): the way it
+        walked before goes on, so a person hidden again soon after is carried on that way."""
         place = self.pose[:2] if self.walked_on else centroid[:2] + self.anchor
         offset = np.zeros(self.model.num_dofs)
         offset[:2] = place - self.estimator.filter.estimate[:2]
+        if self.walked_on:
+            offset[self.legs] = (self.pose - self.estimator.filter.estimate)[self.legs]
         self.estimator.shift(offset)
         self.pose = self.pose.copy()
         self.pose[:2] = place
