@@ -25,6 +25,7 @@ from occupose.tracker import (
     GATE_M,
     INIT_FRAMES,
     LATER_SPEED,
+    LEG_DOFS,
     METHODS,
     MIN_FILL,
     SHAPE_FRAMES,
@@ -615,7 +616,7 @@ def test_a_person_carried_out_of_sight_at_a_walk_stands_its_legs(speed):
     person.occlusion.memory = stride.copy()
     person.path = [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY_FRAMES)]
     person.carry()
-    legs = np.array([n.startswith(("left_hip", "left_knee", "right_hip", "right_knee")) for n in model.dof_names])
+    legs = np.array([n.startswith(LEG_DOFS) for n in model.dof_names])
     assert legs.sum() == 8 and person.walked_on == (speed > WALK_FROM)
     rest = standing_pose(model) if person.walked_on else stride
     np.testing.assert_allclose(person.pose[legs], rest[legs])
