@@ -141,7 +141,7 @@ def score_text(rec, tracks_path: Path) -> str:
 
 def _read_config(path: Path | None) -> dict:
     """Tracker settings from a JSON or TOML file (keys: method, seed and the fields of
-    occupose.tracker.Method, plus cell, max_gap_s, grid_options)."""
+    occupose.tracker.Method, plus cell, max_gap_s, look_back_s, grid_options)."""
     if path is None:
         return {}
     import json

@@ -25,7 +25,9 @@ A frame:
    their feet on the floor, or, standing, reach the feet that show (a thigh seen over a
    hidden shin too); its stature is measured again over its first second upright
    and, once it has been seen from the front a few times, its neck height and shoulder
-   width; its model is resized to them;
+   width; its model is resized to them; LOOK_BACK_FROM frames after its start it is also
+   tracked backwards from its estimate over the frames before the start (walking in from
+   the image's edge; :attr:`Tracker.looked_back`), until its torso is out of view;
 5. a person whose torso is hidden is kept (suspended): carried on at its walking speed if it
    walks (the speed of its last estimates in full view, while recent, or its blob's then)
    and is not at the image's edge, else moved with its blob; one whose blob is gone is kept and carried at
@@ -43,6 +45,7 @@ from __future__ import annotations
 
 import itertools
 import time
+from collections import deque
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
@@ -70,9 +73,10 @@ from occupose.camera import Camera
 from occupose.filters.layered import spread_layers
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
+from occupose.grid.observation import Observation as GridObservation
 from occupose.grid.observation import observations_from_depth, predicted_from_tracks
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
-from occupose.grid.tracking import BlobTracker
+from occupose.grid.tracking import BlobTracker, TrackState
 from occupose.joints import NUM_JOINTS
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
 from occupose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
@@ -170,6 +174,18 @@ INIT_STEPS = 3
 INIT_SPREAD = (0.05, 0.05, 0.05, 0.15, 0.1)
 #: Seconds a track survives without its blob.
 MAX_GAP_S = 3.0
+#: A new person is also tracked backwards over the frames of its blob before its start
+#: (walking in, cut by the image's edge, and the INIT_FRAMES its size is measured on), at
+#: most this many seconds of them, until its torso is hidden (out of view; with occlusion
+#: handling) or its blob was not seen, and those frames are reported (Tracker.looked_back). A person walking in from the side is in view
+#: for 0.8 s before its start in enter_exit_occlusion and sit_behind_table.
+LOOK_BACK_S = 1.0
+#: The backward run starts from the person's estimate this many frames after its start,
+#: through the frames since: a start's legs may be a stride off, which the filter sets
+#: right over the next frames but a backward run from the start pose would carry into the
+#: frames before it (enter_exit_occlusion run 0: ankles 0.3-0.4 m off at the start, right
+#: 5 frames later; from the start pose 0.55 m off before it).
+LOOK_BACK_FROM = 10
 #: A person gone or suspended walks on at the speed of its estimates in full view among
 #: this many last ones, or at its blob's then, whichever is faster (else its pelvis's mean
 #: velocity over them: _Person.step), at most CARRY_SPEED metres per frame (2 m/s at 30 fps).
@@ -261,8 +277,10 @@ class PersonEstimate:
 class _Person:
     """Stage 3 state of one tracked person: model, filter, occlusion state."""
 
-    def __init__(self, model: BodyModel, method: Method, fps: float, rng: np.random.Generator):
+    def __init__(self, model: BodyModel, method: Method, fps: float, rng: np.random.Generator,
+                 backwards: bool = False):
         self.model = model
+        self.backwards = backwards  # runs back in time (Tracker._look_back): it walks the other way
         self.method = method
         self.problem = PoseProblem(model, method.likelihood, fps=fps)
         options = method.filter_options
@@ -321,7 +339,7 @@ class _Person:
         self.since_turn += 1
         if len(self.path) < CARRY_FRAMES or self.since_turn < CARRY_FRAMES:
             return
-        velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps
+        velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps * self._time
         heading = self.problem.heading_dof
         facing = self.pose[heading]
         off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
@@ -410,10 +428,16 @@ class _Person:
         return velocity is not None and float(np.hypot(*velocity)) <= WALK_FROM
 
     def _velocity(self) -> np.ndarray | None:
-        """(2,) m/s of the pelvis over the last WALK_FRAMES estimates; None for fewer."""
+        """(2,) m/s of the pelvis over the last WALK_FRAMES estimates (forward in time, also
+        for a person run backwards); None for fewer."""
         if len(self.path) < WALK_FRAMES:
             return None
-        return (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps
+        return (self.path[-1] - self.path[-WALK_FRAMES]) / (WALK_FRAMES - 1) * self.fps * self._time
+
+    @property
+    def _time(self) -> float:
+        """-1 for a person run back in time (its path goes the way it walked from), else 1."""
+        return -1.0 if self.backwards else 1.0
 
     def step(self) -> np.ndarray:
         """(2,) metres per frame: the faster of two measures of its walk over its last
@@ -569,11 +593,16 @@ class Tracker:
     hold_people : hold the grid cells of the people estimated in the last frame (no moving
         -> static transition there, :func:`occupose.grid.hold.cells_near_capsules`), so a
         person standing or sitting still is not absorbed into the background
+    look_back_s : seconds of a new person's frames before its start tracked backwards
+        (0: none; LOOK_BACK_FROM frames after its start); the tracker keeps a copy of the
+        depth images of that many frames (and LOOK_BACK_FROM more) while some blob has no
+        person yet or a person is that new. After each :meth:`update`, :attr:`looked_back`
+        holds those estimates of the people whose backward run it made.
     """
 
     def __init__(self, cameras, fps: float, method: str = "ours", *, seed: int = 0, cell: float = 0.05,
                  grid_options: Mapping | None = None, max_gap_s: float = MAX_GAP_S, hold_people: bool = True,
-                 **overrides):
+                 look_back_s: float = LOOK_BACK_S, **overrides):
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; valid names: {', '.join(METHODS)}")
         unknown = set(overrides) - set(Method.__dataclass_fields__)
@@ -587,6 +616,8 @@ class Tracker:
         if self.method.model not in ("auto", "full", "upper"):
             raise ValueError(f"model must be 'auto', 'full' or 'upper', got {self.method.model!r}")
         self.model_name = _model_for(cameras) if self.method.model == "auto" else self.method.model
+        if not (np.isfinite(look_back_s) and look_back_s >= 0):
+            raise ValueError(f"look_back_s must be a number of seconds >= 0, got {look_back_s!r}")
         self.spec = spec_from_cameras(cameras, cell=cell)
         self.grid = OccupancyGrid(self.spec, cameras, **dict(grid_options or {}))
         self.blobs = BlobTracker(self.fps, max_gap_s)
@@ -596,6 +627,14 @@ class Tracker:
         self._previous = {}
         self._pending: dict[int, list[np.ndarray]] = {}  # points of tracks not yet started
         self._fragments: set[int] = set()  # blob tracks that split off a tracked person's (see _start)
+        # the last frames' data of the blobs without a person and of the people to be tracked
+        # back (None for a frame without any)
+        looked = round(look_back_s * self.fps)
+        self._history: deque[_Recent | None] = deque(maxlen=looked + LOOK_BACK_FROM if looked else 0)
+        self._new: dict[int, int] = {}  # people to be tracked back: id -> frame of their start
+        #: {track id: [(frames ago, PersonEstimate)]}: the frames before a person's start
+        #: tracked backwards, newest first (set by the update that ran the backward run)
+        self.looked_back: dict[int, list[tuple[int, PersonEstimate]]] = {}
         self.frame = -1
         self.seconds = {"grid": 0.0, "blobs": 0.0, "observations": 0.0, "pose": 0.0}
         self.last_assigned: dict[str, np.ndarray] = {}
@@ -621,8 +660,12 @@ class Tracker:
         thread while stage 3 works on this frame (the paper's IV-B: the grid's kernel
         releases the GIL), and the next call must pass exactly that frame; its hold mask
         then comes from the bodies of the frame before this one.
+
+        After the call, :attr:`looked_back` holds the estimates of earlier frames this call
+        made (a new person tracked back over the frames before its start).
         """
         self.frame += 1
+        self.looked_back = {}
         clock = time.perf_counter()
         if self._grid_job is not None:  # this frame's grid update ran during the last stage 3
             self._grid_job.result()
@@ -656,11 +699,15 @@ class Tracker:
         for tid in seen:
             if tid in owner:
                 pid = owner[tid]
-                out[pid] = self._step(tid, self.people[pid], observations[tid], depths, assigned, states[tid].centroid)
+                out[pid] = self._step(tid, self.people[pid], observations[tid], depths, assigned, states[tid])
             else:
                 person = self._start(tid, observations[tid], depths, assigned, seen[tid])
                 if person is not None:
                     out[tid] = person.estimate(True)
+                    if self._history.maxlen:
+                        self._new[tid] = self.frame
+        if self._history.maxlen:
+            self._remember(seen, owner, observations, depths, assigned)
         for pid, person in self.people.items():
             if pid not in out:  # gone (behind something): kept, not estimated
                 person.carry()
@@ -788,9 +835,49 @@ class Tracker:
         spread[model.dof_names.index("heading")] = heading
         return spread
 
-    def _step(self, tid, person: _Person, observation, depths, assigned, centroid) -> PersonEstimate:
+    def _remember(self, seen, owner, observations, depths, assigned) -> None:
+        """Keep this frame's data of the blobs without a person and of the people to be
+        tracked back (:meth:`_look_back`), and run the backward runs that are due."""
+        for pid, start in list(self._new.items()):
+            person = self.people.get(pid)
+            if person is None or person.lost or self.frame - start >= LOOK_BACK_FROM:
+                del self._new[pid]
+                if person is not None and not person.lost:
+                    self.looked_back[pid] = self._look_back(person, self.frame - start)
+        kept = [t for t in seen if (t not in owner and t not in self._fragments) or owner.get(t) in self._new]
+        states = self.blobs.states
+        self._history.append(_Recent({c: np.array(d) for c, d in depths.items()}, assigned,
+                                     {t: (observations[t], states[t]) for t in kept}) if kept else None)
+
+    def _look_back(self, person: _Person, since: int) -> list[tuple[int, PersonEstimate]]:
+        """[(frames ago, PersonEstimate)], newest first: a person who started ``since``
+        frames ago, tracked back in time from this frame's estimate over its blob's kept
+        frames (while its blob was seen), by a person of its model run backwards
+        (:class:`_Person`'s ``backwards``: the blob's velocity reversed, and it faces away
+        from the way its path goes), until its torso is hidden (walking in from the image's
+        edge) or it has nothing in view: the estimates of the frames before its start."""
+        tid, out = person.blob, []
+        back = _Person(person.model, self.method, self.fps, np.random.default_rng(self._seeds.spawn(1)[0]),
+                       backwards=True)
+        back.estimator.initialise(person.pose, self._spread(person.model))
+        back.centroid, back.blob = person.centroid, tid
+        back.settle(person.pose, -self.blobs.states[tid].velocity)
+        for ago, frame in enumerate(reversed(self._history), start=1):
+            if frame is None or tid not in frame.blobs:
+                break
+            observation, state = frame.blobs[tid]
+            estimate = self._step(tid, back, observation, frame.depths, frame.assigned,
+                                  replace(state, velocity=-state.velocity))
+            if back.lost or not estimate.visible.any():
+                break
+            if ago > since:
+                out.append((ago, estimate))
+        return out
+
+    def _step(self, tid, person: _Person, observation, depths, assigned, state) -> PersonEstimate:
+        """One frame of a tracked person: ``state`` is its blob's TrackState in that frame."""
         active = scale = None
-        centroid = np.asarray(centroid, float)
+        centroid = np.asarray(state.centroid, float)
         if person.lost:
             person.come_back(centroid)
         moved = person.pose.copy()
@@ -837,11 +924,26 @@ class Tracker:
                 shins = [side for side in shins if side not in shown]
                 pose = planted_legs(person.model, pose, legs, shins, shown)
                 person.occlusion.memory = np.where(person.occlusion.active_dofs(), person.occlusion.memory, pose)
-        person.settle(pose, self.blobs.states[tid].velocity)
+        person.settle(pose, state.velocity)
         person.face_the_way_walked()
         person.learn_stature(seen)
         person.learn_shape(seen)
         return person.estimate(True)
+
+
+@dataclass
+class _Recent:
+    """One frame's data of the blobs without a person and of the people just started, kept
+    for :meth:`Tracker._look_back`.
+
+    depths : camera name -> (H, W) float32 metres (a copy); assigned : camera name -> (H, W)
+    int32 track id of each pixel; blobs : {track id: (its occupose.grid.observation
+    Observation, its TrackState)}
+    """
+
+    depths: dict[str, np.ndarray]
+    assigned: dict[str, np.ndarray]
+    blobs: dict[int, tuple[GridObservation, TrackState]]
 
 
 @dataclass
@@ -875,23 +977,25 @@ def track_frames(tracker: Tracker, frames, num_frames: int, progress=None, overl
     total = 0.0
     frames = itertools.islice(frames, num_frames)
     upcoming = next(frames, None)
-    n = -1
+    indices = []  # of the frames taken so far
     while upcoming is not None:
-        n += 1
         frame, upcoming = upcoming, next(frames, None)
+        indices.append(frame.index)
         start = time.perf_counter()
         estimates = tracker.update(frame.depth, upcoming.depth if overlap and upcoming is not None else None)
         spent = time.perf_counter() - start
-        if n == 0:
+        if len(indices) == 1:
             startup = spent
         else:
             total += spent
-        for tid, est in estimates.items():
+        found = [(tid, frame.index, est) for tid, est in estimates.items()]
+        found += [(tid, indices[-1 - ago], est) for tid, earlier in tracker.looked_back.items() for ago, est in earlier]
+        for tid, index, est in found:
             if tid not in joints:
                 joints[tid] = np.full((num_frames, NUM_JOINTS, 3), np.nan)
                 visible[tid] = np.zeros((num_frames, NUM_JOINTS), bool)
-            joints[tid][frame.index] = est.joints
-            visible[tid][frame.index] = est.visible
+            joints[tid][index] = est.joints
+            visible[tid][index] = est.visible
         if progress is not None:
             progress(1)
     tracker.close()
