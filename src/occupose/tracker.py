@@ -707,7 +707,7 @@ class Tracker:
                     if self._history.maxlen:
                         self._new[tid] = self.frame
         if self._history.maxlen:
-            self._remember(seen, owner, observations, depths, assigned)
+            self._remember(seen, owner, states, observations, depths, assigned)
         for pid, person in self.people.items():
             if pid not in out:  # gone (behind something): kept, not estimated
                 person.carry()
@@ -835,7 +835,7 @@ class Tracker:
         spread[model.dof_names.index("heading")] = heading
         return spread
 
-    def _remember(self, seen, owner, observations, depths, assigned) -> None:
+    def _remember(self, seen, owner, states, observations, depths, assigned) -> None:
         """Keep this frame's data of the blobs without a person and of the people to be
         tracked back (:meth:`_look_back`), and run the backward runs that are due."""
         for pid, start in list(self._new.items()):
@@ -845,7 +845,6 @@ class Tracker:
                 if person is not None and not person.lost:
                     self.looked_back[pid] = self._look_back(person, self.frame - start)
         kept = [t for t in seen if (t not in owner and t not in self._fragments) or owner.get(t) in self._new]
-        states = self.blobs.states
         self._history.append(_Recent({c: np.array(d) for c, d in depths.items()}, assigned,
                                      {t: (observations[t], states[t]) for t in kept}) if kept else None)
 
