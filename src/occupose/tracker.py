@@ -177,8 +177,9 @@ MAX_GAP_S = 3.0
 #: A new person is also tracked backwards over the frames of its blob before its start
 #: (walking in, cut by the image's edge, and the INIT_FRAMES its size is measured on), at
 #: most this many seconds of them, until its torso is hidden (out of view; with occlusion
-#: handling) or its blob was not seen, and those frames are reported (Tracker.looked_back). A person walking in from the side is in view
-#: for 0.8 s before its start in enter_exit_occlusion and sit_behind_table.
+#: handling) or its blob was not seen, and those frames are reported (Tracker.looked_back).
+#: A person walking in from the side is in view for 0.8 s before its start in
+#: enter_exit_occlusion and sit_behind_table.
 LOOK_BACK_S = 1.0
 #: The backward run starts from the person's estimate this many frames after its start,
 #: through the frames since: a start's legs may be a stride off, which the filter sets
