@@ -38,17 +38,16 @@ from scipy import ndimage
 
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import MARGIN, capsules_from_primitives, cells_near_capsules
-from occupose.grid.observation import (
+from occupose.grid.pixels import (
     distance_to_points, observations_from_depth, persons_from_tracks, predicted_from_tracks,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
 from occupose.grid.tracking import BlobTracker
-from occupose.metrics import foreground_scores, pixel_assignment_accuracy
+from occupose.evaluation.metrics import foreground_scores, pixel_assignment_accuracy
 from occupose.synth.body import primitives_from_joints, random_body_shape
 from occupose.synth.generate import frames
-from occupose.synth.noise import apply_noise
-from occupose.synth.primitives import concat
+from occupose.geometry.primitives import concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 

@@ -27,7 +27,7 @@ from occupose.likelihood import View, make_likelihood, observation_from_views
 from occupose.synth import motion as pm
 from occupose.synth import scene
 from occupose.synth.body import primitives_from_joints, random_body_shape
-from occupose.synth.primitives import concat
+from occupose.geometry.primitives import concat
 from occupose.synth.render import render_camera
 
 TITLE = "Likelihoods: one evaluate() of P particles, 2000 observed points (ms, millions of evaluations/s)"

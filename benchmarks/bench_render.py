@@ -18,7 +18,7 @@ from benchmarks import median_ms
 from occupose.synth.body import primitives_from_joints, random_body_shape
 from occupose.synth.generate import frames
 from occupose.synth.noise import apply_noise
-from occupose.synth.primitives import concat
+from occupose.geometry.primitives import concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 

@@ -9,6 +9,7 @@ import pytest
 
 from scipy import stats
 
+from occupose.body.dims import BodyDims, dims_from_joints
 from occupose.body import (BODY_MODELS, limb_angles, body_model, capsules_from_poses, diffuse, diffusion_scales,
                            dims_from_observation, joints_from_poses, pose_from_joints, root_drift,
                            standing_pose)
@@ -19,7 +20,7 @@ from occupose.joints import JOINT_INDEX as J
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.synth import motion as sm
-from occupose.synth.motion import DEFAULT_DIMS
+from occupose.body.dims import DEFAULT_DIMS
 
 D = DEFAULT_DIMS
 
@@ -314,10 +315,10 @@ def test_pose_from_joints_wraps_heading_and_checks_input():
 @pytest.mark.parametrize("clip_name, models", [("dataset-1_walk_normal_001", ("full", "upper")),
                                                  ("dataset-2_wave-right-hand_active_001", ("full",))])
 def test_pose_from_joints_on_real_mocap(mocap, clip_name, models):
-    from occupose.mocap import canonical_from_clip, find_clip, load_clip
+    from occupose.io.mocap import canonical_from_clip, find_clip, load_clip
 
     joints = canonical_from_clip(load_clip(find_clip(clip_name)))
-    dims = sm.dims_from_joints(joints)
+    dims = dims_from_joints(joints)
     for name in models:
         errors = _fit_errors(body_model(name, dims), joints[::15])
         # measured: walk 1.0 cm (full) / 1.8 cm (upper), wave 3.0 cm (full); a rigid torso
@@ -353,7 +354,7 @@ def test_model_fitted_to_ground_truth_explains_the_rendered_person():
     cam = scenario.cameras[0]
     rendered = frame.rendered[cam.name]
     points = points_from_depth(np.where(rendered.person == 1, rendered.depth, 0.0).astype(np.float32), cam)[0]
-    dims = sm.dims_from_joints(scenario.people[0].joints)
+    dims = dims_from_joints(scenario.people[0].joints)
     for name, keep in (("full", points[:, 2] > 0.15), ("upper", points[:, 2] > frame.joints[0, J["pelvis"], 2])):
         m = body_model(name, dims)
         a, b = capsules_from_poses(m, pose_from_joints(m, frame.joints[0])[None])
@@ -380,7 +381,7 @@ def _first_points(seed: int):
         for cam in scenario.cameras:
             depth = np.where(frame.rendered[cam.name].person == 1, frame.depth[cam.name], 0.0).astype(np.float32)
             points.append(points_from_depth(depth, cam)[0])
-    return np.concatenate(points), sm.dims_from_joints(scenario.people[0].joints[:30]).height
+    return np.concatenate(points), dims_from_joints(scenario.people[0].joints[:30]).height
 
 
 def test_dims_from_observation_on_rendered_people():
@@ -412,7 +413,7 @@ def test_dims_from_observation_on_a_model_surface(rng):
         dims_from_observation(np.zeros((5, 3)))
 
 
-def _walker_profiles(dims: sm.BodyDims):
+def _walker_profiles(dims: BodyDims):
     """Breadth profiles of a procedural person of ``dims`` walking towards the camera of
     no_occlusion (seen from the front), every third of 30 frames, with each frame's true
     neck depth below the top of its points."""

@@ -6,8 +6,8 @@ from click.testing import CliRunner
 from PIL import Image
 
 from occupose.cli import main
-from occupose.metrics import write_tracks_csv
-from occupose.recording import Recording
+from occupose.evaluation.metrics import write_tracks_csv
+from occupose.io.recording import Recording
 from occupose.synth.scenarios import SCENARIOS
 
 

@@ -1,4 +1,4 @@
-"""occupose.evaluate: the report and table formatting on hand-made scores, and one tiny
+"""occupose.evaluation.evaluate: the report and table formatting on hand-made scores, and one tiny
 evaluation end to end (no_occlusion, 20 procedural frames, `ours`) through the command line."""
 
 import csv
@@ -10,13 +10,13 @@ import pytest
 from click.testing import CliRunner
 
 from occupose.cli import main
-from occupose.evaluate import (
+from occupose.evaluation.evaluate import (
     RunResult, arm_points, evaluate, hidden_share, intervals_from_mask, mean_row, per_joint_table, render_recording,
     report_markdown, results_table, table_rows, write_results_csv,
 )
 from occupose.joints import JOINTS
-from occupose.metrics import PersonScore, Score, TableRow, arm_epsilons, read_tracks_csv
-from occupose.recording import Recording
+from occupose.evaluation.metrics import PersonScore, Score, TableRow, arm_epsilons, read_tracks_csv
+from occupose.io.recording import Recording
 
 FRAMES = 20
 

@@ -18,11 +18,12 @@ from occupose.grid.occupancy import (
 from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
 from occupose.grid.spec import GridSpec
 from occupose.joints import JOINT_INDEX
-from occupose.metrics import foreground_scores
+from occupose.evaluation.metrics import foreground_scores
 from occupose.synth.generate import frames
 from occupose.synth.body import primitives_from_joints, random_body_shape
-from occupose.synth.noise import apply_noise, depth_std
-from occupose.synth.primitives import box, concat
+from occupose.sensors import depth_std
+from occupose.synth.noise import apply_noise
+from occupose.geometry.primitives import box, concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 

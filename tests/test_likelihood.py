@@ -14,7 +14,7 @@ from occupose.synth import motion as pm
 from occupose.synth import scene
 from occupose.synth.body import primitives_from_joints, random_body_shape
 from occupose.synth.noise import apply_noise
-from occupose.synth.primitives import concat, round_cone
+from occupose.geometry.primitives import concat, round_cone
 from occupose.synth.render import render, render_camera
 
 FULL = BODY_MODELS["full"]
@@ -235,7 +235,7 @@ def test_blocked_points_with_tied_coordinates(rng):
 
 def test_offset_depths_match_reference(rng):
     from occupose.likelihood._samples import offset_depths
-    from occupose.synth.noise import depth_std
+    from occupose.sensors import depth_std
 
     depth = rng.uniform(0.4, 7.5, (30, 40)).astype(np.float32)
     depth[rng.random((30, 40)) < 0.2] = 0.0
@@ -339,7 +339,7 @@ def _test_capsules(rng):
 
 
 def test_free_space_matches_reference(rng):
-    from occupose.synth.noise import depth_std
+    from occupose.sensors import depth_std
 
     view = _test_view(rng)
     a, b, radii, part = _test_capsules(rng)
@@ -384,7 +384,7 @@ def test_camera_samples_of_a_capsule_on_the_cameras_axis():
 
 
 def test_color_matches_reference(rng):
-    from occupose.synth.noise import depth_std
+    from occupose.sensors import depth_std
 
     view = _test_view(rng, color=True)
     a, b, radii, part = _test_capsules(rng)

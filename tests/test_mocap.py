@@ -1,11 +1,11 @@
-"""Tests of occupose.mocap: tiny hand-written files (always) and the shared real clips (when present)."""
+"""Tests of occupose.io.mocap: tiny hand-written files (always) and the shared real clips (when present)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from occupose import mocap as mc
+from occupose.io import mocap as mc
 from occupose.joints import BONES, JOINT_INDEX as J, JOINTS
 
 # ---------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from occupose.body.dims import BodyDims, bone_lengths_from_dims, dims_from_joints
 from occupose.joints import BONES, JOINT_INDEX as J
 from occupose.synth import motion as m
 
@@ -49,7 +50,7 @@ def straight():
 
 
 def test_default_body_is_an_average_adult():
-    dims = m.BodyDims()
+    dims = BodyDims()
     assert dims.height == pytest.approx(1.72)
     j = m.joints_from_pose(m.standing_pose())
     assert dims.hip_height == pytest.approx(0.92)
@@ -64,13 +65,13 @@ def test_default_body_is_an_average_adult():
 
 
 def test_scaled_body_keeps_proportions():
-    small = m.BodyDims().scaled(1.55)
+    small = BodyDims().scaled(1.55)
     assert small.height == pytest.approx(1.55)
-    assert small.thigh / small.shin == pytest.approx(m.BodyDims().thigh / m.BodyDims().shin)
+    assert small.thigh / small.shin == pytest.approx(BodyDims().thigh / BodyDims().shin)
     with pytest.raises(ValueError, match="height"):
-        m.BodyDims().scaled(17.2)
+        BodyDims().scaled(17.2)
     with pytest.raises(ValueError, match="thigh"):
-        m.BodyDims(thigh=-0.4)
+        BodyDims(thigh=-0.4)
 
 
 def test_left_is_left_of_the_facing_direction():
@@ -121,7 +122,7 @@ def test_joints_from_pose_batches_and_checks_shape():
 
 
 def test_leg_inverse_kinematics_round_trip(rng):
-    dims = m.BodyDims()
+    dims = BodyDims()
     n = 200
     poses = np.repeat(m.standing_pose()[None], n, axis=0)
     poses[:, m.HEADING] = rng.uniform(-np.pi, np.pi, n)
@@ -134,41 +135,41 @@ def test_leg_inverse_kinematics_round_trip(rng):
 
 
 def test_bone_lengths_are_constant_and_equal_dims(script):
-    for dims in (m.BodyDims(), m.BodyDims().scaled(1.58)):
+    for dims in (BodyDims(), BodyDims().scaled(1.58)):
         b = m.MotionBuilder((0.0, 0.0), dims=dims).walk([(2.0, 1.0)]).sit_down(0.42).wave("both").stand_up()
         lengths = bone_lengths(b.joints())
-        np.testing.assert_allclose(lengths, np.broadcast_to(m.bone_lengths_from_dims(dims), lengths.shape),
+        np.testing.assert_allclose(lengths, np.broadcast_to(bone_lengths_from_dims(dims), lengths.shape),
                                    atol=1e-6)
     lengths = bone_lengths(script.joints())
     assert np.ptp(lengths, axis=0).max() < 1e-6
 
 
 def test_dims_from_joints_recovers_the_body():
-    dims = m.BodyDims().scaled(1.85)
+    dims = BodyDims().scaled(1.85)
     joints = m.MotionBuilder(dims=dims).walk([(3.0, 0.0)]).joints()
-    found = m.dims_from_joints(joints)
+    found = dims_from_joints(joints)
     for name in ("pelvis_width", "spine", "neck_head", "shoulder_width", "shoulder_drop",
                  "upper_arm", "forearm", "thigh", "shin", "ankle_height", "seat_clearance"):
         assert getattr(found, name) == pytest.approx(getattr(dims, name), abs=1e-6), name
     with pytest.raises(ValueError, match=r"\(T, 15, 3\)"):
-        m.dims_from_joints(joints[0])
+        dims_from_joints(joints[0])
 
 
 @pytest.mark.shared
 def test_dims_from_a_real_clip_drive_the_procedural_skeleton(mocap):
-    from occupose import mocap as mocap_io
+    from occupose.io import mocap as mocap_io
 
     path = mocap / "bandai1" / "dataset-1_walk_normal_001.bvh"
     if not path.exists():
         pytest.skip(f"{path.name} not in the shared data")
     clip = mocap_io.canonical_from_clip(mocap_io.load_clip(path))
-    dims = m.dims_from_joints(clip)
+    dims = dims_from_joints(clip)
     assert 1.4 < dims.height < 2.0
     assert 0.2 < dims.upper_arm < 0.35 and 0.35 < dims.thigh < 0.5
     np.testing.assert_allclose(np.median(bone_lengths(clip)[:, [3, 9, 10]], axis=0),
                                [dims.upper_arm, dims.thigh, dims.shin], atol=0.01)
     joints = m.MotionBuilder(dims=dims).walk([(2.0, 0.0)]).sit_down(0.45).joints()
-    np.testing.assert_allclose(bone_lengths(joints), np.broadcast_to(m.bone_lengths_from_dims(dims),
+    np.testing.assert_allclose(bone_lengths(joints), np.broadcast_to(bone_lengths_from_dims(dims),
                                                                      (len(joints), len(BONES))), atol=1e-6)
 
 
@@ -289,7 +290,7 @@ def test_turn_steps_round_without_sliding():
 
 
 def test_sitting_down_puts_the_pelvis_on_the_seat():
-    dims = m.BodyDims()
+    dims = BodyDims()
     start = m.standing_pose((0.0, 0.0), heading=math.pi)   # facing -x: the seat is towards +x
     b = m.MotionBuilder(start_pose=start).sit_down(0.45, 1.8).sitting(2.0)
     j = b.joints()

@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 
-from occupose.synth import primitives as prim
+from occupose.geometry import primitives as prim
+from occupose.sensors import depth_std
 
 from occupose.synth.noise import (
-    KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, NOISE_MODELS, apply_noise, depth_std,
+    KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, NOISE_MODELS, apply_noise,
 )
 from occupose.synth.render import render
 

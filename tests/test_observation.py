@@ -7,17 +7,17 @@ import pytest
 from occupose.camera import Camera, look_at, points_from_depth
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
-from occupose.grid.observation import (
+from occupose.grid.pixels import (
     FALLBACKS, Observation, _nearest_track, distance_to_points, observations_from_depth,
     persons_from_tracks, predicted_from_tracks,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
 from occupose.grid.tracking import BlobTracker
-from occupose.metrics import foreground_scores, pixel_assignment_accuracy
+from occupose.evaluation.metrics import foreground_scores, pixel_assignment_accuracy
 from occupose.synth.body import primitives_from_joints
 from occupose.synth.noise import apply_noise
-from occupose.synth.primitives import box, concat
+from occupose.geometry.primitives import box, concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 

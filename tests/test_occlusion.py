@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from occupose.occlusion import HIDDEN_CELL, OcclusionState, hidden_parts, sphere_centres
+from occupose.pose.occlusion import HIDDEN_CELL, OcclusionState, hidden_parts, sphere_centres
 
 PARENTS = [-1, 0, 1, 0]
 DOFS = [np.array([0]), np.array([1]), np.array([2]), np.array([3])]

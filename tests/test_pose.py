@@ -7,7 +7,7 @@ needed), the model sized from the ground-truth joints, 1000 observed points per 
 
 The issue's budget "200 particles x 5 layers" for ``apf+ps`` is read as 200 particles with
 annealing layers [3, 1, 1] over the three default partitioned-sampling stages (root, then
-head and arms, then legs: :func:`occupose.pose.default_stages`): 5 layers, i.e. 1000
+head and arms, then legs: :func:`occupose.pose.problem.default_stages`): 5 layers, i.e. 1000
 likelihood evaluations per frame.
 
 Measured (procedural no_occlusion, 90 frames, seeds 0-7, with the default 10 % arm
@@ -30,8 +30,8 @@ import pytest
 from occupose.body import body_model, capsules_from_poses, joints_from_poses, pose_from_joints, standing_pose
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
-from occupose.metrics import frame_errors, is_fail, joint_errors, table_row
-from occupose.pose import (
+from occupose.evaluation.metrics import frame_errors, is_fail, joint_errors, table_row
+from occupose.pose.problem import (
     FLOOR_COST,
     FLOOR_SLACK,
     FOOT_COST,
@@ -49,7 +49,7 @@ from occupose.pose import (
     unseen_arms,
 )
 from occupose.synth.generate import UPPER_BODY_PARTS, frames, person_observations
-from occupose.synth.motion import dims_from_joints
+from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
 NUM_FRAMES = 90  # 3 s at 30 fps: the FAIL rule's 2 s window after its 1 s grace period

@@ -8,11 +8,11 @@ import pytest
 from occupose.body import body_model, capsules_from_poses, joints_from_poses, pose_from_joints, standing_pose
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation
-from occupose.pose import PoseEstimator, PoseProblem
-from occupose.proposals import (FOOT_LOST, feet, forward, limb_dofs, limb_proposals, mirrored_legs,
+from occupose.pose.problem import PoseEstimator, PoseProblem
+from occupose.pose.proposals import (FOOT_LOST, feet, forward, limb_dofs, limb_proposals, mirrored_legs,
                                  reach_towards, unexplained_points)
 from occupose.synth.generate import person_observations
-from occupose.synth.motion import dims_from_joints
+from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
 WRIST = JOINT_INDEX["right_wrist"]
@@ -255,7 +255,7 @@ def test_a_seated_persons_hanging_thigh_is_found_from_the_other_leg(seated, monk
         return np.linalg.norm(joints_from_poses(model, found[None])[0, knee] - true_knee)
 
     errors = {"moving": track(False), "mirrored": track(True)}
-    monkeypatch.setattr("occupose.pose.mirrored_legs", lambda *args, **kwargs: [])
+    monkeypatch.setattr("occupose.pose.problem.mirrored_legs", lambda *args, **kwargs: [])
     errors["feet only"] = track(True)
     assert errors["moving"] > 0.3 and errors["feet only"] > 0.3, errors
     assert errors["mirrored"] < 0.05, errors

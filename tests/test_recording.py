@@ -7,7 +7,7 @@ from PIL import Image
 
 from occupose.camera import Camera, look_at
 from occupose.joints import JOINTS
-from occupose.recording import (
+from occupose.io.recording import (
     Frame,
     GroundTruth,
     Recording,

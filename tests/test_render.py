@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from occupose.camera import look_at
-from occupose.synth import primitives as prim
+from occupose.geometry import primitives as prim
 from occupose.synth.render import AMBIENT, Rendered, render, render_camera
 
 W, H, F = 64, 48, 60.0

@@ -8,11 +8,11 @@ import pytest
 
 from occupose.camera import pixels_from_points
 from occupose.joints import JOINT_INDEX, JOINT_PART, JOINTS, PART_INDEX
-from occupose.recording import Recording
+from occupose.io.recording import Recording
 from occupose.synth import motion as pm
 from occupose.synth.body import primitives_from_joints, random_body_shape
 from occupose.synth.generate import frames, write_scenario
-from occupose.synth.primitives import BOX
+from occupose.geometry.primitives import BOX
 from occupose.synth.scenarios import SCENARIOS, build_scenario
 from occupose.synth.scene import couch, room, table
 from occupose.synth.sequence import chain, facing

@@ -8,14 +8,15 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from occupose.body.dims import DEFAULT_DIMS, dims_from_joints
 from occupose.body import body_model, capsules_from_poses, joints_from_poses, standing_pose
 from occupose.camera import Camera, look_at, raw_depth_from_metres
 from occupose.cli import main
-from occupose.grid.observation import Observation as GridObservation
+from occupose.grid.pixels import Observation as GridObservation
 from occupose.joints import JOINT_INDEX, JOINTS
-from occupose.metrics import frame_errors, joint_errors, read_tracks_csv
-from occupose.occlusion import hidden_parts_in_views, joint_parts, part_tree, planted_legs
-from occupose.recording import Recording, RecordingWriter
+from occupose.evaluation.metrics import frame_errors, joint_errors, read_tracks_csv
+from occupose.pose.occlusion import hidden_parts_in_views, joint_parts, part_tree, planted_legs
+from occupose.io.recording import Recording, RecordingWriter
 from occupose.synth import motion as sm
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
@@ -116,7 +117,7 @@ def narrow_walker():
     no_occlusion (seen from the front), and that shape."""
     import math
 
-    average = sm.DEFAULT_DIMS.scaled(1.75)
+    average = DEFAULT_DIMS.scaled(1.75)
     dims = replace(average, spine=0.78 * average.spine, shoulder_width=0.6 * average.shoulder_width,
                    neck_head=average.neck_head + 0.11 * average.spine)
     scenario = build_scenario("no_occlusion", use_mocap=False)
@@ -146,7 +147,7 @@ def test_a_person_seen_from_the_front_is_resized_once_to_its_neck_and_shoulders(
     kept = unshaped.people[1].model.dims  # the average adult's proportions at the measured stature
     assert not unshaped.people[1].shapes
     for name in ("shoulder_width", "spine", "neck_head"):
-        assert getattr(kept, name) / kept.height == pytest.approx(getattr(sm.DEFAULT_DIMS, name) / sm.DEFAULT_DIMS.height)
+        assert getattr(kept, name) / kept.height == pytest.approx(getattr(DEFAULT_DIMS, name) / DEFAULT_DIMS.height)
 
 
 def test_a_person_picked_up_slowly_from_the_ceiling_gets_its_stature_measured_again():
@@ -170,7 +171,7 @@ def test_a_person_picked_up_slowly_from_the_ceiling_gets_its_stature_measured_ag
     tracker._start = start
     track_frames(tracker, rendered, len(rendered))
     person = tracker.people[1]
-    truth = sm.dims_from_joints(scenario.people[0].joints).height
+    truth = dims_from_joints(scenario.people[0].joints).height
     assert starts[0] < truth - 0.2  # measured 1.448 m for 1.749
     assert len(person.tops) == STATURE_FRAMES and person.problem.stature_known
     assert person.model.dims.height == pytest.approx(np.median(person.tops))

@@ -93,8 +93,8 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
               help="A tracks.csv to draw beside the ground truth.")
 def show_cmd(recording, index, out, tracks) -> None:
     """Write a PNG of one frame: depth colour-mapped, skeletons drawn over it."""
-    from occupose.metrics import read_tracks_csv
-    from occupose.recording import Recording
+    from occupose.evaluation.metrics import read_tracks_csv
+    from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
     try:
@@ -111,7 +111,7 @@ def show_cmd(recording, index, out, tracks) -> None:
 @click.argument("tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def score_cmd(recording, tracks) -> None:
     """Print the Table I row of TRACKS (a tracks.csv) against RECORDING's ground truth."""
-    from occupose.recording import Recording
+    from occupose.io.recording import Recording
 
     try:
         click.echo(score_text(Recording(recording), tracks))
@@ -121,7 +121,7 @@ def score_cmd(recording, tracks) -> None:
 
 def score_text(rec, tracks_path: Path) -> str:
     """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person."""
-    from occupose.metrics import format_table, read_tracks_csv, score
+    from occupose.evaluation.metrics import format_table, read_tracks_csv, score
 
     if not rec.has_groundtruth:
         raise ValueError(f"{rec.path}: no groundtruth.csv, nothing to score against")
@@ -161,7 +161,7 @@ def run_tracking(rec, out: Path, method: str, seed: int, **settings) -> tuple[Pa
     """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json; returns (tracks path, result)."""
     import json
 
-    from occupose.metrics import write_tracks_csv
+    from occupose.evaluation.metrics import write_tracks_csv
     from occupose.tracker import track_recording
 
     out.mkdir(parents=True, exist_ok=True)
@@ -192,7 +192,7 @@ def run_tracking(rec, out: Path, method: str, seed: int, **settings) -> tuple[Pa
 def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config) -> None:
     """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json and prints
     the Table I row when the recording has ground truth."""
-    from occupose.recording import Recording
+    from occupose.io.recording import Recording
 
     settings = _read_config(config)
     if layers is not None:
@@ -232,8 +232,8 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
 def demo_cmd(out, scenario, frames, method) -> None:
     """Render a built-in scenario with procedural motion (no shared data needed), track it,
     print the Table I row and picture a frame with the skeletons."""
-    from occupose.metrics import read_tracks_csv
-    from occupose.recording import Recording
+    from occupose.evaluation.metrics import read_tracks_csv
+    from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
     rec_path = _write_synth(scenario, out / scenario, seed=0, frames=frames, sensor=None, force=True,
@@ -271,8 +271,8 @@ def demo_cmd(out, scenario, frames, method) -> None:
               help="Folder for recordings/, runs/, results.csv, report.md and the plots (recordings are reused).")
 def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
-    from occupose.evaluate import evaluate, table_rows
-    from occupose.metrics import markdown_table
+    from occupose.evaluation.evaluate import evaluate, table_rows
+    from occupose.evaluation.metrics import markdown_table
 
     bars = []  # opened at the first report, once evaluate has checked its input and knows the total
 

@@ -3,7 +3,7 @@
 One :class:`Tracker` holds everything that lives across frames: the occupancy grid
 (stage 1), the blob tracker (stage 2) and one :class:`_Person` per tracked blob (stage 3:
 a body model, a particle filter and, for methods with occlusion handling, the visible /
-hidden state machine of :mod:`occupose.occlusion`). :meth:`Tracker.update` takes one frame
+hidden state machine of :mod:`occupose.pose.occlusion`). :meth:`Tracker.update` takes one frame
 of depth images and returns every tracked person's 15 canonical joints, each flagged
 visible (estimated from this frame's data) or not (carried from memory).
 
@@ -15,7 +15,7 @@ A frame:
 2. moving cells are labelled into blobs, blobs tracked (ids persist);
 3. every tracked blob's pixels go to its person; where people touch, each pixel goes
    to the nearest predicted body (exclusion principle; a new person's body is made of
-   its previous points, see :func:`occupose.grid.observation.predicted_from_tracks`);
+   its previous points, see :func:`occupose.grid.pixels.predicted_from_tracks`);
 4. per person: a new track starts once its blob's own points have been tall enough and
    fully in view for a few frames (body size from their points, a search over headings
    facing where it walks or the camera, standing or sitting); a known one first runs the
@@ -73,15 +73,15 @@ from occupose.camera import Camera
 from occupose.filters.layered import spread_layers
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
-from occupose.grid.observation import Observation as GridObservation
-from occupose.grid.observation import observations_from_depth, predicted_from_tracks
+from occupose.grid.pixels import Observation as GridObservation
+from occupose.grid.pixels import observations_from_depth, predicted_from_tracks
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.tracking import BlobTracker, TrackState
 from occupose.joints import NUM_JOINTS
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
-from occupose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
-from occupose.pose import PoseEstimator, PoseProblem
-from occupose.proposals import feet, unexplained_points
+from occupose.pose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
+from occupose.pose.problem import PoseEstimator, PoseProblem
+from occupose.pose.proposals import feet, unexplained_points
 from occupose.synth import motion as procedural
 
 
@@ -94,7 +94,7 @@ class Method:
         filters without layers); a model with another number of stages gets the same total
         spread from the root down (the upper model: (2, 1, 2) -> (3, 2))
     likelihood : name in occupose.likelihood.LIKELIHOODS
-    occlusion : whether hidden parts are detected and left out (occupose.occlusion; the
+    occlusion : whether hidden parts are detected and left out (occupose.pose.occlusion; the
         full model only: the upper model is for ceiling cameras, where furniture hides
         no part of the upper body)
     model : "full", "upper" or "auto" (``upper`` for a camera looking steeply down)
@@ -937,7 +937,7 @@ class _Recent:
     for :meth:`Tracker._look_back`.
 
     depths : camera name -> (H, W) float32 metres (a copy); assigned : camera name -> (H, W)
-    int32 track id of each pixel; blobs : {track id: (its occupose.grid.observation
+    int32 track id of each pixel; blobs : {track id: (its occupose.grid.pixels
     Observation, its TrackState)}
     """
 
@@ -1006,7 +1006,7 @@ def track_frames(tracker: Tracker, frames, num_frames: int, progress=None, overl
 
 def track_recording(recording, method: str = "ours", *, seed: int = 0, progress=None, overlap: bool = False,
                     **settings) -> TrackingResult:
-    """Track every person of an open :class:`occupose.recording.Recording`.
+    """Track every person of an open :class:`occupose.io.recording.Recording`.
 
     method, seed, settings : as :class:`Tracker` (settings: Method fields, ``cell``,
     ``grid_options``, ``max_gap_s``); progress : callable(n) after each frame, or None;

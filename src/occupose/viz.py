@@ -8,7 +8,7 @@ import numpy as np
 
 from occupose.camera import pixels_from_points
 from occupose.joints import BONES
-from occupose.recording import Recording
+from occupose.io.recording import Recording
 
 
 def _depth_colors():

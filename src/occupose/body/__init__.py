@@ -4,7 +4,7 @@ estimation and motion model (see :mod:`occupose.body.model` for the conventions)
 from occupose.body.fit import LIMB_DOFS, limb_angles, pose_from_joints, standing_pose
 from occupose.body.kinematics import capsules_from_poses, joints_from_poses
 from occupose.body.model import BODY_MODELS, BodyModel, Partition, body_model, full_model, upper_model
-from occupose.body.motion import BOUNDARY_MODES, DIFFUSION_30FPS, diffuse, diffusion_scales, root_drift
+from occupose.body.dynamics import BOUNDARY_MODES, DIFFUSION_30FPS, diffuse, diffusion_scales, root_drift
 from occupose.body.size import BodySize, dims_from_observation
 
 __all__ = [

@@ -7,7 +7,7 @@ turned) coordinate axes. The root's parent is the world; its translational DOFs 
 the world frame. At the zero pose every frame is aligned with the world: x forward, y to
 the person's left, z up (the person stands upright facing +x, arms and legs hanging).
 
-Every model part is a set of round cones (capsules, :data:`occupose.synth.primitives.ROUND_CONE`):
+Every model part is a set of round cones (capsules, :data:`occupose.geometry.primitives.ROUND_CONE`):
 end ``a`` (radius ra) to end ``b`` (radius rb), each end a fixed offset in a node's frame.
 
 Two built-in models (:data:`BODY_MODELS`, :func:`body_model`):
@@ -68,7 +68,7 @@ from typing import NamedTuple
 import numpy as np
 
 from occupose.joints import JOINTS
-from occupose.synth.motion import DEFAULT_DIMS, BodyDims
+from occupose.body.dims import DEFAULT_DIMS, BodyDims
 
 TRANSLATION, ROTATION = 0, 1
 
@@ -92,7 +92,7 @@ class BodyModel:
     dof_names : (D,) str; limits : (D, 2) float64, radians or metres
     angular : (D,) bool, True for angles; periodic : (D,) bool, angles that wrap in
         [-pi, pi) instead of stopping at their limits (the heading)
-    kinds : (D,) str, the DOF's kind for default diffusion scales (see occupose.body.motion)
+    kinds : (D,) str, the DOF's kind for default diffusion scales (see occupose.body.dynamics)
     node_names : (J,) str; parents : (J,) int64, -1 for the root; offsets : (J, 3) metres
     dof_node : (D,) int64, the node each DOF turns or moves; dof_type : (D,) int64,
         TRANSLATION or ROTATION; dof_axis : (D,) int64, 0/1/2 = local x/y/z;

@@ -43,7 +43,8 @@ import numpy as np
 
 from occupose.body.kinematics import capsules_from_poses
 from occupose.body.model import FULL_RADII, BodyModel, full_model
-from occupose.synth.motion import ARM_REST, DEFAULT_DIMS, BodyDims
+from occupose.body.dims import DEFAULT_DIMS, BodyDims
+from occupose.body.postures import ARM_REST
 
 #: Rank of the point taken as the top of the head (counted from the highest, 1-based).
 TOP_RANK = 10

@@ -27,7 +27,7 @@ import numpy as np
 
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
-from occupose.synth.primitives import BOX, ROUND_CONE, Primitives
+from occupose.geometry.primitives import BOX, ROUND_CONE, Primitives
 
 #: Default margin (metres) around each capsule: the half diagonal of a 5 cm cell (a cell
 #: whose centre is that far from the surface can still hold surface points) plus about
@@ -77,7 +77,7 @@ def capsules_from_primitives(prims: Primitives) -> tuple[np.ndarray, np.ndarray,
     Returns a, b : (K, 3) float64 world metres and radii : (K, 2) float64 metres.
     """
     if not isinstance(prims, Primitives):
-        raise ValueError(f"prims must be occupose.synth.primitives.Primitives, got {type(prims).__name__}")
+        raise ValueError(f"prims must be occupose.geometry.primitives.Primitives, got {type(prims).__name__}")
     cone = prims.kind == ROUND_CONE
     longest = np.argmax(prims.size, axis=1)
     rows = np.arange(len(prims))

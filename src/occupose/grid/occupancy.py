@@ -112,7 +112,7 @@ import numpy as np
 from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
-from occupose.synth.noise import depth_std, depth_std_coefficients
+from occupose.sensors import depth_std, depth_std_coefficients
 
 #: Cell states (index into the last axis of ``OccupancyGrid.probabilities``).
 O, M, E = 0, 1, 2

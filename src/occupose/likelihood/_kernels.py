@@ -23,8 +23,8 @@ import math
 import numba
 import numpy as np
 
-from occupose.synth._kernels import _depth
-from occupose.synth.primitives import ELLIPSOID, ROUND_CONE
+from occupose.geometry._raycast import _depth
+from occupose.geometry.primitives import ELLIPSOID, ROUND_CONE
 
 # Below this value of |b - a|^2 - (ra - rb)^2 (m^2) a round cone is treated as its larger sphere.
 _DEGENERATE = 1e-12

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from occupose.likelihood import _kernels
-from occupose.synth.noise import depth_std_coefficients
+from occupose.sensors import depth_std_coefficients
 
 #: Angles of the samples about a capsule's axis, either side of the camera-facing direction,
 #: degrees: 45 keeps them inside the silhouette of a limb whose model is up to ~40 % too thick.

@@ -14,7 +14,7 @@ import numpy as np
 
 from occupose.joints import JOINT_INDEX as J
 from occupose.joints import PART_INDEX as P
-from occupose.synth.primitives import Primitives, box, concat, ellipsoid, round_cone
+from occupose.geometry.primitives import Primitives, box, concat, ellipsoid, round_cone
 
 #: Clothing styles: "normal" (everyday colours), "dark" (near-black, the second paper's
 #: S1) and "flashy" (saturated, a different colour per body part: its S2).

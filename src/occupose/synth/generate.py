@@ -20,10 +20,10 @@ import numpy as np
 
 from occupose.camera import pixels_from_points, raw_depth_from_metres
 from occupose.joints import JOINT_PART, PARTS
-from occupose.recording import RecordingWriter
+from occupose.io.recording import RecordingWriter
 from occupose.synth.body import primitives_from_joints
 from occupose.synth.noise import apply_noise
-from occupose.synth.primitives import Primitives, concat, select
+from occupose.geometry.primitives import Primitives, concat, select
 from occupose.synth.render import Rendered, render_camera
 from occupose.synth.scenarios import Scenario
 

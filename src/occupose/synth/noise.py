@@ -11,8 +11,8 @@ pixels that were 0 stay 0, and a model may add invalid pixels of its own.
 - ``"tof"`` (time of flight, Kinect v2 / Azure Kinect): Gaussian depth noise, flying pixels
   at depth edges, random dropouts, a working range.
 
-:func:`depth_std` gives each model's random depth error (one standard deviation) at a
-distance, the figure the occupancy grid uses as its measurement tolerance.
+The random depth error of each model (one standard deviation at a distance) is
+:func:`occupose.sensors.depth_std`, the figure the occupancy grid uses as its tolerance.
 """
 
 from __future__ import annotations
@@ -22,47 +22,13 @@ from typing import Callable
 
 import numpy as np
 
+from occupose.sensors import depth_std_coefficients
 from occupose.synth import _kernels
 
 #: Kinect v1 raw disparity to depth: 1 / z = OFFSET - STEP * raw (z in metres). The
 #: widely used fit of the OpenKinect / ROS drivers; one raw unit is about 1/8 pixel.
 KINECT_V1_INVERSE_DEPTH_OFFSET = 3.3309495161
 KINECT_V1_INVERSE_DEPTH_STEP = 0.0030711016
-
-
-#: Random depth error of each model as a quadratic c0 + c1 z + c2 z^2 (metres, z in metres).
-_STD_COEFFS: dict[str, np.ndarray] = {
-    "none": np.zeros(3),
-    # Nguyen, Izadi & Lovell (2012), Kinect v1 axial noise at moderate surface angles:
-    # 0.0012 + 0.0019 (z - 0.4)^2, expanded.
-    "structured_light": np.array([0.0012 + 0.0019 * 0.16, -0.0019 * 0.8, 0.0019]),
-    # Fankhauser et al. (2015), Kinect v2 axial noise at normal incidence:
-    # 1.5 - 0.5 z + 0.3 z^2 mm. Below 5.3 mm over 0.5-4.5 m, within the Azure Kinect's
-    # specified random error (standard deviation <= 17 mm over its 0.5-3.86 m range).
-    "tof": np.array([1.5e-3, -0.5e-3, 0.3e-3]),
-}
-
-
-def depth_std(z, model: str):
-    """Random depth error (one standard deviation, metres) of ``model`` at depth ``z``.
-
-    z : float or (...) array, metres. Returns a float for a scalar ``z``, else an array
-    of the same shape (float64). ``"structured_light"``: 0.0012 + 0.0019 (z - 0.4)^2
-    (Nguyen et al. 2012), including the disparity quantisation; ``"tof"``: (1.5 - 0.5 z +
-    0.3 z^2) mm (Fankhauser et al. 2015); ``"none"``: 0. Systematic (bias) errors of real
-    sensors are not modelled.
-    """
-    c0, c1, c2 = depth_std_coefficients(model)
-    values = np.asarray(z, dtype=np.float64)
-    std = c0 + c1 * values + c2 * values**2
-    return float(std) if std.ndim == 0 else std
-
-
-def depth_std_coefficients(model: str) -> np.ndarray:
-    """(3,) float64 c0, c1, c2: :func:`depth_std` of ``model`` is c0 + c1 z + c2 z^2 metres."""
-    if model not in _STD_COEFFS:
-        raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(_STD_COEFFS)}")
-    return _STD_COEFFS[model].copy()
 
 
 def _check_depth(depth) -> np.ndarray:
@@ -127,7 +93,7 @@ def structured_light_noise(depth, rng: np.random.Generator, *, fx: float | None 
     STEP`` (one unit is about 1/8 pixel), gets Gaussian noise, is rounded to a whole unit
     and turned back into depth, so depth is quantised in steps of ``STEP * z^2`` (about
     0.00307 z^2 m); the Gaussian part is chosen so that noise and rounding together have
-    the standard deviation ``depth_std(z, "structured_light")``. Returns (H, W) float32.
+    the standard deviation ``occupose.sensors.depth_std(z, "structured_light")``. Returns (H, W) float32.
     """
     z = _check_depth(depth)
     _check_rng(rng)
@@ -138,7 +104,7 @@ def structured_light_noise(depth, rng: np.random.Generator, *, fx: float | None 
     out = np.empty(z.shape, np.float32)
     _kernels.structured_light_pixels(
         z, rng, float(fx or 0.0) * float(baseline), bool(shadows), float(min_range), float(max_range),
-        _STD_COEFFS["structured_light"], KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, out,
+        depth_std_coefficients("structured_light"), KINECT_V1_INVERSE_DEPTH_OFFSET, KINECT_V1_INVERSE_DEPTH_STEP, out,
     )
     return _drop(out, rng, dropout)
 
@@ -158,7 +124,7 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
 
     A flying pixel mixes the two surfaces its footprint straddles: its depth moves a
     uniform random share of the way towards the neighbour most different from it. Every
-    measured pixel then gets Gaussian noise of ``depth_std(z, "tof")``. Returns (H, W) float32.
+    measured pixel then gets Gaussian noise of ``occupose.sensors.depth_std(z, "tof")``. Returns (H, W) float32.
     """
     z = _check_depth(depth)
     _check_rng(rng)
@@ -169,7 +135,7 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
         raise ValueError(f"edge_jump must be > 0 metres, got {edge_jump!r}")
     out = np.empty(z.shape, np.float32)
     _kernels.tof_pixels(z, rng, flying_fraction, float(edge_jump), float(min_range), float(max_range),
-                        _STD_COEFFS["tof"], out)
+                        depth_std_coefficients("tof"), out)
     return _drop(out, rng, dropout)
 
 

@@ -2,7 +2,7 @@
 
 Every pixel casts one ray through its centre (pixel ``(u, v)`` is column ``u``, row ``v``,
 centres at integer coordinates) and takes the nearest exact analytic hit among the
-boxes, ellipsoids and round cones of a :class:`~occupose.synth.primitives.Primitives`
+boxes, ellipsoids and round cones of a :class:`~occupose.geometry.primitives.Primitives`
 batch. Depth is the camera z of the hit (not the ray length); colour is the albedo
 shaded by a headlight (Lambert term of a light at the camera plus ambient).
 
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from occupose.synth import _kernels
-from occupose.synth.primitives import BOX, ELLIPSOID, ROUND_CONE, Primitives
+from occupose.geometry.primitives import BOX, ELLIPSOID, ROUND_CONE, Primitives
 
 #: Share of the albedo a surface shows when lit at grazing incidence (the rest is the
 #: headlight's Lambert term).
@@ -58,7 +58,7 @@ def render(prims: Primitives, width: int, height: int, fx: float, fy: float, cx:
 
     Parameters
     ----------
-    prims : Primitives, K solids in world metres (see :mod:`occupose.synth.primitives`)
+    prims : Primitives, K solids in world metres (see :mod:`occupose.geometry.primitives`)
     width, height : int, image size in pixels
     fx, fy, cx, cy : float, pinhole intrinsics in pixels
     world_from_camera : (4, 4) float, rigid transform from the camera frame (OpenCV axes) to the world

@@ -23,12 +23,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from occupose.body.dims import BodyDims, DEFAULT_DIMS, dims_from_joints
 from occupose.camera import Camera, camera_preset, look_at, sensor_spec
 from occupose.joints import JOINT_INDEX as J
-from occupose.mocap import canonical_from_clip, facing_from_joints as facing, find_clip, load_clip, place, resample
+from occupose.io.mocap import canonical_from_clip, facing_from_joints as facing, find_clip, load_clip, place, resample
 from occupose.synth import motion as pm
 from occupose.synth.body import BodyShape, random_body_shape
-from occupose.synth.primitives import Primitives, concat
+from occupose.geometry.primitives import Primitives, concat
 from occupose.synth.scene import chair, cabinet, couch, room, table
 from occupose.synth.sequence import chain
 
@@ -88,7 +89,7 @@ class _Motion:
     is kept as its actions on a builder that starts where the segment before it ends).
     """
 
-    def __init__(self, use_mocap: bool, start_xy, heading: float, dims: pm.BodyDims):
+    def __init__(self, use_mocap: bool, start_xy, heading: float, dims: BodyDims):
         self.use_mocap = use_mocap
         self.dims = dims
         self.start = (start_xy, heading)
@@ -108,11 +109,11 @@ class _Motion:
         last = None if seconds is None else first + int(round(seconds * FPS))
         joints = place(joints[first:last], fps=FPS)
         if not any(source.startswith("mocap:") for source in self.sources):
-            self._resize(pm.dims_from_joints(joints))  # the first real clip sets this person's body size
+            self._resize(dims_from_joints(joints))  # the first real clip sets this person's body size
         self.sources.add(f"mocap:{path.stem}")
         return joints
 
-    def _resize(self, dims: pm.BodyDims) -> None:
+    def _resize(self, dims: BodyDims) -> None:
         """Go on with ``dims``: the start pose and every procedural segment so far rebuilt."""
         self.dims = dims
         self.segments[0] = pm.joints_from_pose(pm.standing_pose(*self.start, dims)[None], dims)
@@ -173,8 +174,8 @@ def _source(*motions: _Motion) -> str:
     return ", ".join(sorted(set().union(*(m.sources for m in motions))))
 
 
-def _dims(rng: np.random.Generator) -> pm.BodyDims:
-    return pm.DEFAULT_DIMS.scaled(float(np.clip(rng.normal(1.74, 0.07), 1.58, 1.92)))
+def _dims(rng: np.random.Generator) -> BodyDims:
+    return DEFAULT_DIMS.scaled(float(np.clip(rng.normal(1.74, 0.07), 1.58, 1.92)))
 
 
 # ----------------------------------------------------------------------------- cameras

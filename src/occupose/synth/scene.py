@@ -2,14 +2,14 @@
 
 Every builder takes its footprint centre ``(x, y)`` on the floor in world metres and a
 ``heading`` in radians (about z; 0 means the furniture's front faces +x) and returns a
-:class:`~occupose.synth.primitives.Primitives` batch with ``person = 0``.
+:class:`~occupose.geometry.primitives.Primitives` batch with ``person = 0``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from occupose.synth.primitives import Primitives, box, concat
+from occupose.geometry.primitives import Primitives, box, concat
 
 WOOD = (150, 105, 60)
 FABRIC = (95, 110, 140)

@@ -15,7 +15,7 @@ import numpy as np
 from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
 from occupose.filters import apply_limits, make_filter
 from occupose.likelihood import Observation, make_likelihood, point_distances
-from occupose.proposals import limb_proposals, mirrored_legs
+from occupose.pose.proposals import limb_proposals, mirrored_legs
 
 
 #: Default share of the particles given to each limb proposal (see PoseEstimator).
@@ -109,7 +109,7 @@ class PoseProblem:
         #: heading's part (people walk forwards); None for none. Set per frame by the tracker.
         self.walking: tuple[float, float] | None = None
         #: Whether the person stands (feet on the floor: their points say where the legs
-        #: go, see :func:`occupose.proposals.feet`); set per frame by the tracker.
+        #: go, see :func:`occupose.pose.proposals.feet`); set per frame by the tracker.
         self.standing = False
         #: Whether ``model.dims.height`` is the person's stature measured well: only then
         #: does a model without legs cost a head above it (the reach term). True by default;
@@ -332,9 +332,9 @@ class PoseEstimator:
     rng : np.random.Generator; velocity_damping : share of the root's last translation
     added to every particle before a step (constant-velocity prediction; 0 = none);
     proposals : share of the particles whose arm or leg tries where the points unexplained
-    by the last estimate suggest, per limb (:func:`occupose.proposals.limb_proposals`), and
+    by the last estimate suggest, per limb (:func:`occupose.pose.proposals.limb_proposals`), and
     whose leg tries the other leg's angles for a still person with bent legs
-    (:func:`occupose.proposals.mirrored_legs`; 0 = none); before each step the arms with
+    (:func:`occupose.pose.proposals.mirrored_legs`; 0 = none); before each step the arms with
     no points of their own under the last estimate are put under the hanging-arm term
     (:func:`unseen_arms`, :attr:`PoseProblem.resting`);
     filter_options : e.g. ``num_layers``

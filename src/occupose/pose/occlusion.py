@@ -33,7 +33,7 @@ import numpy as np
 from occupose.body import BodyModel, joints_from_poses, limb_angles
 from occupose.camera import Camera, pixels_from_points
 from occupose.joints import JOINT_INDEX
-from occupose.proposals import forward, reach_towards
+from occupose.pose.proposals import forward, reach_towards
 
 #: Grid visibility code of a hidden cell (see occupose.grid.occupancy).
 HIDDEN_CELL = 2
@@ -225,7 +225,7 @@ def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsu
     and other people do. A pixel without a measurement hides nothing.
 
     This is the test of the paper's III-D with the depth images in place of the grid's
-    cell visibility (:func:`occupose.occlusion.hidden_parts`): a sphere on a limb's axis
+    cell visibility (:func:`occupose.pose.occlusion.hidden_parts`): a sphere on a limb's axis
     lies a few centimetres behind the person's own measured surface, in a cell the grid
     calls hidden, so the grid test hides visible parts (the paper notes this for seated
     legs); the pixel's owner tells the person's own surface from the scene's.
@@ -260,7 +260,7 @@ def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins
     the model's ankle height, the least bent such leg, the shin near vertical; for the
     ``shins`` (legs whose thigh is seen, its shin hidden) only the knee bend, the thigh
     left as it is. Where ``feet`` (side -> (3,) ankle, world metres, as
-    :func:`occupose.proposals.feet` finds them) shows a leg's foot, the leg reaches it
+    :func:`occupose.pose.proposals.feet` finds them) shows a leg's foot, the leg reaches it
     instead: the knee bent forwards (the ankle as near it as the knee bend gets it, for a
     shin).
 

@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from occupose.joints import JOINTS
-from occupose.metrics import (
+from occupose.evaluation.metrics import (
     ARM_PARTS, MIN_ARM_POINTS, Score, TableRow, arm_epsilons, frame_errors, joint_errors, markdown_table, match_tracks, score,
     write_tracks_csv,
 )
@@ -75,7 +75,7 @@ Progress = Callable[[int, int], None]
 class RunResult:
     """One method on one scenario with one seed.
 
-    score : the Table I scores of every ground-truth person (occupose.metrics.Score)
+    score : the Table I scores of every ground-truth person (occupose.evaluation.metrics.Score)
     person_ids : ground-truth person ids, in the order of ``score.persons``
     frame_errors : (T, P) float64, metres: D_t of each person over the joints the matched
         track reports (NaN where the person is not counted or has no estimate)
@@ -221,7 +221,7 @@ def run_method(recording: Path, scenario: str, method: str, seed: int, out: Path
                progress: Callable[[int], None] | None = None, **settings) -> RunResult:
     """Track ``recording`` with ``method`` and ``seed`` into ``out``/tracks.csv and
     ``out``/summary.json, and score it against the recording's ground truth."""
-    from occupose.recording import Recording
+    from occupose.io.recording import Recording
     from occupose.tracker import track_recording
 
     rec = Recording(recording)
@@ -524,7 +524,7 @@ def _arm_section(runs: Sequence[RunResult], methods: list[str]) -> list[str]:
             "Mean over the frames with at least "
             f"{MIN_ARM_POINTS} arm points seen and an estimate, and over the runs, of the mean distance from "
             "the person's arm points (upper arms, forearms, hands in the part labels; every camera) to the "
-            "nearest arm bone of the skeleton (occupose.metrics). Lowest per sequence in bold. The points lie "
+            "nearest arm bone of the skeleton (occupose.evaluation.metrics). Lowest per sequence in bold. The points lie "
             "on the surface, so the ground truth's skeleton has an epsilon too (last column): what a perfect "
             "skeleton scores.", "",
             _markdown(["sequence", *methods, "ground truth"], rows), ""]
@@ -544,7 +544,7 @@ def report_markdown(runs: Sequence[RunResult], plots: Sequence[Path] = (), root:
         lines.append("Frames: " + ", ".join(f"{s} {n}" for s, n in frames.items()) + ".")
     lines += ["", "Each value is the mean over the runs (runs without any estimate are left out of "
               "the mean and std); Status is FAIL when any run FAILs (the 2-second rolling mean of D_t "
-              "exceeds 25 cm after the first second; occupose.metrics). Best value of each column per "
+              "exceeds 25 cm after the first second; occupose.evaluation.metrics). Best value of each column per "
               "sequence in **bold**.", "", "## Table I: all joints", "", markdown_table(table_rows(runs)), "",
               "## Table I: ground-truth-visible joints only", "", markdown_table(table_rows(runs, visible=True)), ""]
     fails = []
@@ -622,7 +622,7 @@ def write_plots(runs: Sequence[RunResult], out: Path, recordings: dict[str, Path
     import matplotlib
 
     matplotlib.use("Agg")
-    from occupose.recording import Recording
+    from occupose.io.recording import Recording
 
     methods = list(dict.fromkeys(r.method for r in runs))
     colors = {m: f"C{i}" for i, m in enumerate(methods)}

@@ -35,7 +35,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from occupose.joints import BONES, JOINT_INDEX, JOINTS, NUM_JOINTS
+from occupose.joints import BONES, JOINT_INDEX, NUM_JOINTS
 from occupose.paths import mocap_dir
 
 #: Height of the ankle joint above the floor when standing, metres.

@@ -1,0 +1,1 @@
+"""Scoring tracks against ground truth (Table I of the first paper), reports and the evaluation runner."""

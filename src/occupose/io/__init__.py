@@ -1,0 +1,1 @@
+"""Readers and writers: the recording folder, joint tables, motion-capture files."""
