@@ -7,7 +7,11 @@ import platform
 import time
 from pathlib import Path
 
-from benchmarks import (
+from occupose._numba import configure
+
+configure()  # before any benchmark imports numba
+
+from benchmarks import (  # noqa: E402
     bench_blobs,
     bench_body,
     bench_filters,

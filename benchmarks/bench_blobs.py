@@ -5,7 +5,7 @@ grid of 5 cm cells, over a sequence of frames (tracker state carried over), medi
 percentile of the per-frame times. Moving cells from two sources: (a) the cells holding
 the rendered points of 1-3 people walking side by side (the ``no_occlusion`` walk, frames
 0-59, copies 0.8 m nearer and farther and 0.5 m apart), a clean mask; (b) the HMM grid
-itself on ``two_people_crossing`` (frames 0-129, noise components included). For (b) also the time of `observations_from_depth` (one
+itself on ``two_people_crossing`` (frames 0-129, noise components included). For (b) also the time of `pixels_from_depth` (one
 640x480 camera, previous-observation bodies). The load average is reported: the cores
 are shared with other processes.
 
@@ -39,7 +39,7 @@ from scipy import ndimage
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import MARGIN, capsules_from_primitives, cells_near_capsules
 from occupose.grid.pixels import (
-    distance_to_points, observations_from_depth, persons_from_tracks, predicted_from_tracks,
+    distance_to_points, pixels_from_depth, persons_from_tracks, predicted_from_tracks,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
@@ -116,7 +116,7 @@ def run(num_frames: int = 60) -> list[dict]:
         tracks = tracker.update(blobs)
         middle = time.perf_counter()
         bodies = predicted_from_tracks(tracker.states, previous, crossing.fps)
-        previous, _ = observations_from_depth(frame.depth, crossing.cameras, BOX, labels, tracks,
+        previous, _ = pixels_from_depth(frame.depth, crossing.cameras, BOX, labels, tracks,
                                               states=grid.states, predicted=bodies)
         end = time.perf_counter()
         label_track.append(middle - begin)
@@ -124,7 +124,7 @@ def run(num_frames: int = 60) -> list[dict]:
         counts.append(len(blobs))
     rows.append(_row("label + track, HMM grid (two_people_crossing)", 2, len(masks),
                      _time_sequence(masks, crossing.fps, BOX), float(np.mean(counts))))
-    rows.append(_row("observations_from_depth, HMM grid (two_people_crossing)", 2, len(masks),
+    rows.append(_row("pixels_from_depth, HMM grid (two_people_crossing)", 2, len(masks),
                      np.array(observe[5:]), float(np.mean(counts))))
     return rows
 
@@ -181,7 +181,7 @@ def _runs(name, pipelines, *, seed=0):
             tracks = trackers[p].update(blobs)
             bodies = _bodies(kind, trackers[p], previous[p], scenario.fps, tracks)
             centers = {tid: s.centroid for tid, s in trackers[p].states.items() if tid in tracks}
-            previous[p], assigned = observations_from_depth(frame.depth, scenario.cameras, spec, labels, tracks,
+            previous[p], assigned = pixels_from_depth(frame.depth, scenario.cameras, spec, labels, tracks,
                                                             states=states, centers=centers, predicted=bodies)
             out[p].append((assigned[cam.name], truth, frame.present.copy()))
     return out

@@ -82,8 +82,7 @@ def run_accuracy() -> list[dict]:
         tracker = Tracker(scene.cameras, scene.fps, method, seed=0)
         assigned, truth = [], []
         for frame in frames(scene, seed=0, num_frames=count):
-            tracker.update(frame.depth)
-            assigned.append(tracker.last_assigned[camera].copy())
+            assigned.append(tracker.update(frame.depth).assigned[camera].copy())
             truth.append(frame.rendered[camera].person.astype(np.int64))
         person_of = persons_from_tracks(assigned, truth)
         lut = np.zeros(max([0, *person_of]) + 1, np.int64)

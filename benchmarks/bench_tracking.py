@@ -30,12 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
-from occupose.body import body_model, pose_from_joints
+from occupose.body import body_model, joints_from_pose, pose_from_joints
 from occupose.joints import JOINT_INDEX
 from occupose.evaluation.evaluate import ARM_SAMPLE
 from occupose.evaluation.metrics import ARM_PARTS, arm_epsilons, frame_errors, is_fail, joint_errors
 from occupose.paths import mocap_dir
-from occupose.pose.problem import PoseEstimator, PoseProblem
+from occupose.pose.estimator import PoseEstimator
+from occupose.pose.problem import PoseProblem
 from occupose.synth.generate import UPPER_BODY_PARTS, person_observations
 from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
@@ -88,7 +89,7 @@ def _track(model_name, gt, observations, filter_name, particles, options, seed):
         start = time.perf_counter()
         pose = estimator.step(observation)
         seconds.append(time.perf_counter() - start)
-        estimates.append(estimator.joints(pose))
+        estimates.append(joints_from_pose(model, pose))
     return np.array(estimates), np.array(seconds), estimator.filter.diagnostics["likelihood_evaluations"]
 
 

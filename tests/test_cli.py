@@ -1,13 +1,17 @@
 """The command line end to end on a tiny synthetic recording."""
 
+import json
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
 from PIL import Image
 
+from occupose.camera import raw_depth_from_metres
 from occupose.cli import main
-from occupose.evaluation.metrics import write_tracks_csv
-from occupose.io.recording import Recording
+from occupose.config import TrackerConfig
+from occupose.evaluation.metrics import read_tracks_csv, write_tracks_csv
+from occupose.io.recording import Recording, RecordingWriter
 from occupose.synth.scenarios import SCENARIOS
 
 
@@ -124,3 +128,95 @@ def test_demo_tracks_scores_and_pictures(tmp_path):
     assert len(pictures) == 1 and "picture: " in result.output
     result = CliRunner().invoke(main, ["demo", "--out", str(tmp_path / "early"), "--frames", "10"])
     assert result.exit_code == 0 and "nobody is in view in the first 10 frames" in result.output
+
+
+def test_track_command_writes_tracks_and_summary(tmp_path, walk):
+    scenario, rendered = walk
+    rec = tmp_path / "rec"
+    with RecordingWriter(rec, list(scenario.cameras), scenario.fps) as writer:
+        for f in rendered[:25]:
+            writer.write_frame({c.name: raw_depth_from_metres(f.depth[c.name], c) for c in scenario.cameras})
+        writer.write_groundtruth(np.stack([f.joints for f in rendered[:25]]),
+                                 np.stack([f.visible for f in rendered[:25]]), [1])
+    out = tmp_path / "out"
+    settings = tmp_path / "settings.toml"
+    settings.write_text('method = "ours"\n[pose]\ngate_m = 0.3\n[carry]\nrejoin_m = 0.8\n')
+    result = CliRunner().invoke(main, ["track", str(rec), "--out", str(out), "--particles", "100",
+                                       "--layers", "2,1,1", "--config", str(settings), "--set", "start.samples=30"])
+    assert result.exit_code == 0, result.output
+    assert "1 track(s) in 25 frames" in result.output and "person 1 (track 1) all joints" in result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["method"] == "ours" and summary["seed"] == 0
+    assert summary["model"] == "full"  # what auto chose for a front camera
+    assert summary["frames"] == 25 and summary["people"] == 1 and summary["fps"] > 0
+    # the whole resolved config: the file's, the flags' and --set's values, the method's defaults
+    config = TrackerConfig.from_dict(summary["config"])
+    assert config == TrackerConfig().with_values({"pose.particles": 100, "pose.layers": (2, 1, 1), "pose.gate_m": 0.3,
+                                                  "carry.rejoin_m": 0.8, "start.samples": 30})
+    tracks = read_tracks_csv(out / "tracks.csv", 25)
+    assert list(tracks) == [1] and np.isfinite(tracks[1][0][-1]).all()
+
+
+def test_track_command_bad_input(tmp_path, small_camera):
+    runner = CliRunner()
+    result = runner.invoke(main, ["track", str(tmp_path), "--out", str(tmp_path / "o")])
+    assert result.exit_code != 0 and "recording.json" in result.output
+    config = tmp_path / "c.json"
+    config.write_text("[1, 2]")
+    rec = tmp_path / "rec"
+    with RecordingWriter(rec, [small_camera], 30.0) as writer:
+        writer.write_frame({"cam": np.zeros((120, 160), np.uint16)})
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--config", str(config)])
+    assert result.exit_code != 0 and "a config must be a table of sections" in result.output
+    config.write_text('{"pose": {"occlusion": "false"}}')
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--config", str(config)])
+    assert result.exit_code != 0 and "unknown setting 'pose.occlusion'; pose has:" in result.output
+    config.write_text('{"occlusion": {"enabled": "false"}}')
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--config", str(config)])
+    assert result.exit_code != 0 and "occlusion.enabled must be true or false, got 'false' (str)" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--filter", "nonsense"])
+    assert result.exit_code != 0 and "pose.filter must be one of sir, apf, ps, apf+ps, part-based" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--set", "pose.gate_m"])
+    assert result.exit_code != 0 and "--set takes KEY=VALUE" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--layers", "x"])
+    assert result.exit_code != 0 and "--layers must be an integer" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--method", "magic"])
+    assert result.exit_code != 0 and "unknown method 'magic'" in result.output
+    result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 0 and "nobody was tracked" in result.output
+    assert Recording(rec).num_frames == 1
+
+
+def test_an_empty_recording_is_refused_clearly(tmp_path, small_camera):
+    rec = tmp_path / "empty"
+    with RecordingWriter(rec, [small_camera], 30.0):
+        pass
+    result = CliRunner().invoke(main, ["track", str(rec), "--out", str(tmp_path / "o")])
+    assert result.exit_code != 0 and "the recording has no frames, nothing to track" in result.output
+
+
+
+def test_a_filter_given_alone_takes_the_layers_it_accepts(tmp_path, small_camera):
+    """--filter ps on ours (annealed in 2, 1, 2 layers): ps has no layers, apf one number,
+    apf+ps on ps (no layers) ours' layers."""
+    from occupose.cli import build_config
+
+    config, name = build_config(None, None, {"pose.filter": "ps"})
+    assert name == "ours" and config.pose.filter == "ps" and config.pose.layers is None
+    config, _ = build_config(None, None, {"pose.filter": "apf"})
+    assert config.pose.layers == 5  # the same 5 layers in one stage
+    config, _ = build_config(None, "ps", {"pose.filter": "apf+ps"})
+    assert config.pose.layers == (2, 1, 2)  # ours' split
+
+
+def test_config_command_prints_settings_that_read_back(tmp_path):
+    runner = CliRunner()
+    result = runner.invoke(main, ["config", "--method", "apf", "--set", "pose.particles=300", "--set",
+                                  "grid.max_range=4.0"])
+    assert result.exit_code == 0, result.output
+    assert 'method = "apf"' in result.output and "particles = 300" in result.output
+    assert "# noise_model = none" in result.output  # TOML has no none
+    path = tmp_path / "printed.toml"
+    path.write_text(result.output)
+    expected = TrackerConfig.from_dict({"method": "apf", "pose": {"particles": 300}, "grid": {"max_range": 4.0}})
+    assert TrackerConfig.from_file(path) == expected

@@ -8,7 +8,7 @@ from occupose.camera import Camera, look_at, points_from_depth
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
 from occupose.grid.pixels import (
-    FALLBACKS, Observation, _nearest_track, distance_to_points, observations_from_depth,
+    FALLBACKS, PersonPixels, _nearest_track, distance_to_points, pixels_from_depth,
     persons_from_tracks, predicted_from_tracks,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
@@ -69,7 +69,7 @@ def test_two_cameras_split_their_own_pixels():
     labels, blobs = blobs_from_mask(mask, SPEC)
     tracks = BlobTracker(30.0).update(blobs)
     depths = {name: view.depth for name, view in views.items()}
-    observations, assigned = observations_from_depth(depths, [CAMERA, SIDE], SPEC, labels, tracks)
+    observations, assigned = pixels_from_depth(depths, [CAMERA, SIDE], SPEC, labels, tracks)
     for name, view in views.items():
         truth = view.person.astype(np.int64)
         assert accuracy(assigned[name], truth, persons_from_tracks([assigned[name]], [truth])) == 1.0
@@ -83,7 +83,7 @@ def test_pixels_go_to_the_track_of_their_cell():
     rendered = scene(-0.6, 0.6)
     labels, blobs = oracle_labels(rendered)
     tracks = BlobTracker(30.0).update(blobs)
-    observations, assigned = observations_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks)
+    observations, assigned = pixels_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks)
     image = assigned["cam"]
     truth = rendered.person.astype(np.int64)
     assert image.dtype == np.int32 and image.shape == (120, 160)
@@ -94,7 +94,7 @@ def test_pixels_go_to_the_track_of_their_cell():
     assert precision == 1.0 and recall > 0.99  # the wall behind is nobody's
     points, pixels = points_from_depth(rendered.depth, CAMERA)
     for tid, obs in observations.items():
-        assert isinstance(obs, Observation) and obs.track_id == tid
+        assert isinstance(obs, PersonPixels) and obs.track_id == tid
         np.testing.assert_array_equal(obs.pixels["cam"], np.flatnonzero(image.reshape(-1) == tid))
         np.testing.assert_allclose(obs.points, points[np.isin(pixels, obs.pixels["cam"])])
 
@@ -107,14 +107,14 @@ def test_shared_blob_goes_to_the_nearest_predicted_body():
     person = truth.reshape(-1)[pixels]
     tracks = {7: blob, 9: blob}
     bodies = {7: distance_to_points(points[person == 1]), 9: distance_to_points(points[person == 2])}
-    _, assigned = observations_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks, predicted=bodies)
+    _, assigned = pixels_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks, predicted=bodies)
     assert accuracy(assigned["cam"], truth, {7: 1, 9: 2}) == 1.0
     # the centroid fallback splits at the middle plane, which here is right too...
     centers = {7: np.array([-0.15, 2.0, 0.85]), 9: np.array([0.15, 2.0, 0.85])}
-    _, by_centre = observations_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks, centers=centers)
+    _, by_centre = pixels_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks, centers=centers)
     assert accuracy(by_centre["cam"], truth, {7: 1, 9: 2}) > 0.99
     # ...and where a body does not reach (or a track has none), the centre distance counts
-    _, mixed = observations_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks,
+    _, mixed = pixels_from_depth({"cam": rendered.depth}, [CAMERA], SPEC, labels, tracks,
                                        centers=centers, predicted={7: bodies[7]})
     mixed = mixed["cam"].reshape(-1)[pixels]
     assert np.all(mixed[person == 1] == 7)
@@ -163,7 +163,7 @@ def test_predicted_from_tracks_uses_the_last_observation_moved_on():
         tracker.update(blobs_from_mask(mask, spec)[1])
     state = tracker.states[1]
     assert state.velocity[0] == pytest.approx(1.0)
-    before = Observation(1, {"cam": np.arange(2)}, {"cam": np.array([[0.0, 0.0, 1.0], [0.0, 0.1, 1.0]])})
+    before = PersonPixels(1, {"cam": np.arange(2)}, {"cam": np.array([[0.0, 0.0, 1.0], [0.0, 0.1, 1.0]])})
     bodies = predicted_from_tracks(tracker.states, {1: before}, 10.0)
     np.testing.assert_allclose(bodies[1](np.array([[0.1, 0.0, 1.0], [0.05, 0.0, 1.0]])), [0.0, 0.05], atol=1e-12)
     own = predicted_from_tracks(tracker.states, {}, 10.0)[1]  # no observation yet: its cells
@@ -186,20 +186,20 @@ def test_bad_input_to_observations():
     tracks = {1: blobs[0]}
     depths = {"cam": rendered.depth}
     with pytest.raises(ValueError, match="integer array of the grid's shape"):
-        observations_from_depth(depths, [CAMERA], SPEC, labels[:-1], tracks)
+        pixels_from_depth(depths, [CAMERA], SPEC, labels[:-1], tracks)
     with pytest.raises(ValueError, match="depths must map each camera name"):
-        observations_from_depth({"other": rendered.depth}, [CAMERA], SPEC, labels, tracks)
+        pixels_from_depth({"other": rendered.depth}, [CAMERA], SPEC, labels, tracks)
     with pytest.raises(ValueError, match="valid names"):
-        observations_from_depth(depths, [CAMERA], SPEC, labels, tracks, fallback="nearest")
+        pixels_from_depth(depths, [CAMERA], SPEC, labels, tracks, fallback="nearest")
     with pytest.raises(ValueError, match="positive int track ids to Blob"):
-        observations_from_depth(depths, [CAMERA], SPEC, labels, {0: blobs[0]})
+        pixels_from_depth(depths, [CAMERA], SPEC, labels, {0: blobs[0]})
     with pytest.raises(ValueError, match="may only name tracked ids"):
-        observations_from_depth(depths, [CAMERA], SPEC, labels, tracks, centers={2: np.zeros(3)})
+        pixels_from_depth(depths, [CAMERA], SPEC, labels, tracks, centers={2: np.zeros(3)})
     with pytest.raises(ValueError, match="depth image for camera"):
-        observations_from_depth({"cam": rendered.depth[:-1]}, [CAMERA], SPEC, labels, tracks)
+        pixels_from_depth({"cam": rendered.depth[:-1]}, [CAMERA], SPEC, labels, tracks)
     with pytest.raises(ValueError, match=r"\(M, 3\)"):
         distance_to_points(np.zeros((0, 3)))
-    observations, assigned = observations_from_depth(depths, [CAMERA], SPEC, labels, {})
+    observations, assigned = pixels_from_depth(depths, [CAMERA], SPEC, labels, {})
     assert observations == {} and not assigned["cam"].any()
 
 
@@ -264,7 +264,7 @@ def run_pipeline(scenario, indices, *, warm_up=0, seed=0, oracle_from=None, orac
             tracker = trackers[kind]
             tracks = tracker.update(blobs)
             bodies_ahead = predicted_from_tracks(tracker.states, previous[kind], scenario.fps)
-            previous[kind], assigned = observations_from_depth({cam.name: depth}, [cam], spec, labels, tracks,
+            previous[kind], assigned = pixels_from_depth({cam.name: depth}, [cam], spec, labels, tracks,
                                                                states=states, predicted=bodies_ahead)
             merged = {tid: s.merged_with for tid, s in tracker.states.items() if tid in tracks}
             out[kind].append((assigned[cam.name], truth, present, merged))

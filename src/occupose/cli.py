@@ -39,6 +39,9 @@ def _clear_output(out: Path, force: bool) -> None:
 @click.version_option(package_name="occupose")
 def main() -> None:
     """Track the 3D skeletons of people in depth-camera recordings."""
+    from occupose._numba import configure
+
+    configure()
 
 
 @main.command("scenarios")
@@ -139,81 +142,103 @@ def score_text(rec, tracks_path: Path) -> str:
     return "\n".join(lines)
 
 
-def _read_config(path: Path | None) -> dict:
-    """Tracker settings from a JSON or TOML file (keys: method, seed and the fields of
-    occupose.tracker.Method, plus cell, max_gap_s, look_back_s, grid_options)."""
-    if path is None:
-        return {}
-    import json
+def _value(text: str):
+    """A ``--set`` value: TOML syntax (``0.3``, ``true``, ``[2, 1, 2]``, ``"tof"``), else the text."""
     import tomllib
 
     try:
-        text = path.read_text()
-        config = tomllib.loads(text) if path.suffix == ".toml" else json.loads(text)
-    except (OSError, ValueError) as error:
-        _fail(f"{path}: cannot read the config ({error})")
-    if not isinstance(config, dict):
-        _fail(f"{path}: the config must be a table of settings, got {type(config).__name__}")
-    return config
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
 
 
-def run_tracking(rec, out: Path, method: str, seed: int, **settings) -> tuple[Path, object]:
+def build_config(config_file: Path | None, method: str | None, values: dict, assignments: tuple[str, ...] = ()):
+    """The run's TrackerConfig: the config file's settings (TOML or JSON: an optional
+    ``method``, the base, and sections of settings, see docs/configuration.md) on
+    ``--method`` (instead of the file's method), then the flags ``values`` (dotted keys;
+    None: not given), then the ``--set KEY=VALUE`` ``assignments``. Returns (config, the
+    method name it is based on)."""
+    from occupose.config import ConfigError, TrackerConfig, read_settings
+
+    try:
+        data = {} if config_file is None else read_settings(config_file)
+        name = data["method"] = method or data.get("method", "ours")
+        config = TrackerConfig.from_dict(data, source=str(config_file or "the command line"))
+        given = {k: v for k, v in values.items() if v is not None}
+        if "pose.filter" in given and "pose.layers" not in given:
+            given["pose.layers"] = _layers_for(given["pose.filter"], config.pose.layers)
+        for assignment in assignments:
+            key, sign, text = assignment.partition("=")
+            if not sign:
+                _fail(f"--set takes KEY=VALUE (e.g. pose.gate_m=0.3), got {assignment!r}")
+            given[key.strip()] = _value(text.strip())
+        return config.with_values(given), name
+    except ConfigError as error:
+        _fail(str(error))
+
+
+def _layers_for(filter_name: str, layers):
+    """The layers a filter given by --filter alone takes from the method's ``layers``: none
+    for a filter without annealing, the same total in one stage for ``apf``, the method's
+    own for ``apf+ps`` (else the ``apf`` and ``ours`` methods' defaults)."""
+    from occupose.config import METHODS
+
+    if filter_name == "apf":
+        return sum(layers) if isinstance(layers, tuple) else layers or METHODS["apf"].pose.layers
+    if filter_name == "apf+ps":
+        return layers if layers is not None else METHODS["ours"].pose.layers
+    return None
+
+
+def run_tracking(rec, out: Path, config, method: str | None, seed: int) -> tuple[Path, object]:
     """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json; returns (tracks path, result)."""
-    import json
+    from occupose.run import track_recording, write_run
 
-    from occupose.evaluation.metrics import write_tracks_csv
-    from occupose.tracker import track_recording
+    with _progress_bar(rec.num_frames, f"tracking ({method or 'custom'})") as bar:
+        result = track_recording(rec, config, seed=seed, progress=bar.update)
+    return write_run(out, result, rec.path, method), result
 
-    out.mkdir(parents=True, exist_ok=True)
-    with _progress_bar(rec.num_frames, f"tracking ({method})") as bar:
-        result = track_recording(rec, method, seed=seed, progress=bar.update, **settings)
-    tracks_path = out / "tracks.csv"
-    write_tracks_csv(tracks_path, result.tracks)
-    summary = {"recording": str(rec.path), **result.settings, "frames": result.num_frames,
-               "people": len(result.tracks), "seconds": {k: round(v, 4) for k, v in result.seconds.items()},
-               "fps": round(result.fps, 2)}
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    return tracks_path, result
+
+def _layers(text: str | None):
+    """--layers: an integer or integers separated by commas."""
+    if text is None:
+        return None
+    try:
+        parsed = [int(x) for x in text.split(",")]
+    except ValueError:
+        _fail(f"--layers must be an integer or integers separated by commas, got {text!r}")
+    return parsed[0] if len(parsed) == 1 else tuple(parsed)
 
 
 @main.command("track")
 @click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Folder for tracks.csv and summary.json.")
-@click.option("--method", default=None, help="ours (default), apf, ps or part-based.")
+@click.option("--method", default=None, help="ours (default), apf, ps or part-based: the base of the settings.")
 @click.option("--model", type=click.Choice(["auto", "full", "upper"]), default=None,
               help="Body model; auto (default): upper for a ceiling camera, full otherwise.")
 @click.option("--filter", "filter_name", default=None, help="Particle filter (sir, apf, ps, apf+ps, part-based).")
 @click.option("--likelihood", default=None, help="Likelihood (points, points+free, render, ...).")
 @click.option("--particles", type=click.IntRange(min=1), default=None, help="Particles per person.")
 @click.option("--layers", default=None, help="Annealing layers: an integer or one per stage, e.g. 3,1,1.")
-@click.option("--seed", type=click.IntRange(min=0), default=None, help="Random seed (default 0).")
-@click.option("--config", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
-              help="JSON or TOML file of settings; options given on the command line win.")
-def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config) -> None:
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Random seed.")
+@click.option("--config", "config_file", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+              help="TOML or JSON file of settings (see docs/configuration.md); options given here win.")
+@click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
+              help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable).")
+def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config_file,
+              assignments) -> None:
     """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json and prints
     the Table I row when the recording has ground truth."""
     from occupose.io.recording import Recording
 
-    settings = _read_config(config)
-    if layers is not None:
-        try:
-            parsed = [int(x) for x in layers.split(",")]
-        except ValueError:
-            _fail(f"--layers must be an integer or integers separated by commas, got {layers!r}")
-        layers = parsed[0] if len(parsed) == 1 else tuple(parsed)
-    given = {"model": model, "filter": filter_name, "likelihood": likelihood, "particles": particles,
-             "layers": layers}
-    settings.update({k: v for k, v in given.items() if v is not None})
-    config_method, config_seed = settings.pop("method", "ours"), settings.pop("seed", 0)
-    method = method or config_method
-    seed = config_seed if seed is None else seed
-    if isinstance(settings.get("layers"), list):
-        settings["layers"] = tuple(settings["layers"])
+    values = {"pose.model": model, "pose.filter": filter_name, "pose.likelihood": likelihood,
+              "pose.particles": particles, "pose.layers": _layers(layers)}
+    config, name = build_config(config_file, method, values, assignments)
     try:
         rec = Recording(recording)
         if rec.num_frames == 0:
             _fail(f"{recording}: the recording has no frames, nothing to track")
-        tracks_path, result = run_tracking(rec, out, method, seed, **settings)
+        tracks_path, result = run_tracking(rec, out, config, name, seed)
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
     click.echo(f"{len(result.tracks)} track(s) in {result.num_frames} frames at {result.fps:.1f} frames/s "
@@ -222,6 +247,25 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
         click.echo("nobody was tracked (no moving person-sized blob in the recording)")
     if rec.has_groundtruth:
         click.echo(score_text(rec, tracks_path))
+
+
+@main.command("config")
+@click.option("--method", default=None, help="ours (default), apf, ps or part-based.")
+@click.option("--config", "config_file", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+              help="TOML or JSON file of settings.")
+@click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE", help="Any setting by its dotted name.")
+def config_cmd(method, config_file, assignments) -> None:
+    """Print every setting of a run as TOML, a file that --config reads back. TOML has no
+    none: settings that are none are written as comments (the method's value stands)."""
+    import tomli_w
+
+    config, name = build_config(config_file, method, {}, assignments)
+    lines = [f"# occupose settings: method {name} with the changes given", tomli_w.dumps({"method": name}).rstrip()]
+    for section, fields in config.to_dict().items():
+        lines.append(f"\n[{section}]")
+        for key, value in fields.items():
+            lines.append(f"# {key} = none" if value is None else tomli_w.dumps({key: value}).rstrip())
+    click.echo("\n".join(lines))
 
 
 @main.command("demo")
@@ -246,8 +290,9 @@ def demo_cmd(out, scenario, frames, method) -> None:
     hidden = 100.0 * (1 - gt.visible[np.isfinite(gt.joints[..., 0])].mean())
     click.echo(f"ground truth: {len(gt.person_ids)} person(s), {hidden:.1f} % of their joint observations hidden "
                "(furniture, other people, their own body, image border)")
+    config, name = build_config(None, method, {})
     try:
-        tracks_path, result = run_tracking(rec, out / f"{scenario}-{method}", method, 0)
+        tracks_path, result = run_tracking(rec, out / f"{scenario}-{method}", config, name, 0)
     except ValueError as error:
         _fail(str(error))
     click.echo(f"{len(result.tracks)} track(s) at {result.fps:.1f} frames/s (start-up excluded) -> {tracks_path}")

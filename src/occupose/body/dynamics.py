@@ -14,7 +14,8 @@ are kept by one of :data:`BOUNDARY_MODES`:
 
 Periodic DOFs (the heading) are wrapped to [-pi, pi) in every mode.
 
-Default scales (:data:`DIFFUSION_30FPS`, by DOF kind) are per frame at 30 frames/s, the
+Default scales (:data:`DIFFUSION_30FPS`, by DOF kind, the defaults of
+:class:`occupose.config.DiffusionConfig`) are per frame at 30 frames/s, the
 typical displacement in a frame of ordinary motion (walking at 1.3 m/s moves the root
 4 cm a frame; an arm swing turns the shoulder 0.05 .. 0.1 rad a frame). Being per frame
 displacements of smooth motion, they scale with the frame interval (30 / fps), not its
@@ -23,26 +24,29 @@ square root.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
 from occupose.body.model import TRANSLATION, BodyModel
+from occupose.config import DiffusionConfig
 
 #: Diffusion standard deviation per frame at 30 frames/s by DOF kind, metres or radians.
-DIFFUSION_30FPS: dict[str, float] = {
-    "root_xy": 0.02, "root_z": 0.01, "heading": 0.05, "trunk": 0.03, "neck": 0.04, "neck_twist": 0.02,
-    "shoulder": 0.08, "elbow": 0.10, "forearm_twist": 0.08, "hip": 0.06, "knee": 0.08,
-}
+DIFFUSION_30FPS: dict[str, float] = dataclasses.asdict(DiffusionConfig())
 
 BOUNDARY_MODES = ("reflect", "reject", "clip")
 
 
-def diffusion_scales(model: BodyModel, fps: float = 30.0, scale: float = 1.0, **overrides: float) -> np.ndarray:
+def diffusion_scales(model: BodyModel, fps: float = 30.0, scale: float = 1.0, *,
+                     per_kind: Mapping[str, float] | None = None, **overrides: float) -> np.ndarray:
     """Diffusion standard deviations per frame for ``model``'s DOFs, (D,) float64.
 
-    fps : frame rate, frames/s (the 30 fps defaults are multiplied by 30 / fps)
-    scale : multiplies every default
+    fps : frame rate, frames/s (the 30 fps values are multiplied by 30 / fps)
+    scale : multiplies every value
+    per_kind : the values at 30 fps by DOF kind (every kind of :data:`DIFFUSION_30FPS`);
+        default DIFFUSION_30FPS
     overrides : per DOF kind (``root_xy``, ``shoulder``, ... see :data:`DIFFUSION_30FPS`)
         or per DOF name (``left_elbow=0.2``), per frame at ``fps``, not scaled; names win
         over kinds.
@@ -58,7 +62,10 @@ def diffusion_scales(model: BodyModel, fps: float = 30.0, scale: float = 1.0, **
             raise ValueError(f"unknown DOF kind or name {key!r}; valid: {', '.join(sorted(valid))}")
         if not (math.isfinite(value) and value >= 0):
             raise ValueError(f"diffusion scale {key}={value!r} must be a finite number >= 0")
-    out = np.array([DIFFUSION_30FPS[kind] for kind in model.kinds]) * scale * 30.0 / fps
+    per_kind = DIFFUSION_30FPS if per_kind is None else per_kind
+    if set(per_kind) != set(DIFFUSION_30FPS):
+        raise ValueError(f"per_kind must give every DOF kind {sorted(DIFFUSION_30FPS)}, got {sorted(per_kind)}")
+    out = np.array([per_kind[kind] for kind in model.kinds]) * scale * 30.0 / fps
     for i, (name, kind) in enumerate(zip(model.dof_names, model.kinds)):
         if name in overrides:
             out[i] = overrides[name]

@@ -59,3 +59,9 @@ def joints_from_poses(model: BodyModel, poses) -> np.ndarray:
     _kernel(poses.shape[0])(poses, *_tree(model), model.joint_nodes, model.joint_offsets, out,
                             _EMPTY_NODES, _EMPTY_OFFSETS, np.empty((poses.shape[0], 0, 3)))
     return out
+
+
+def joints_from_pose(model: BodyModel, pose) -> np.ndarray:
+    """The 15 canonical joints of one pose (D,) of ``model``: (15, 3) float64 world metres,
+    NaN where the model does not report a joint (:func:`joints_from_poses` of one)."""
+    return joints_from_poses(model, np.asarray(pose, float)[None])[0]

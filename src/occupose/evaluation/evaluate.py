@@ -36,17 +36,17 @@ import multiprocessing
 import os
 import queue as queue_module
 import shutil
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field, fields
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from occupose.joints import JOINTS
 from occupose.evaluation.metrics import (
     ARM_PARTS, MIN_ARM_POINTS, Score, TableRow, arm_epsilons, frame_errors, joint_errors, markdown_table, match_tracks, score,
-    write_tracks_csv,
 )
 
 #: Methods compared when none are named.
@@ -218,20 +218,19 @@ def _tracked_frame_errors(gt_joints: np.ndarray, gt_visible: np.ndarray, tracks:
 
 
 def run_method(recording: Path, scenario: str, method: str, seed: int, out: Path,
-               progress: Callable[[int], None] | None = None, **settings) -> RunResult:
-    """Track ``recording`` with ``method`` and ``seed`` into ``out``/tracks.csv and
-    ``out``/summary.json, and score it against the recording's ground truth."""
+               progress: Callable[[int], None] | None = None, overrides: Mapping[str, Any] | None = None
+               ) -> RunResult:
+    """Track ``recording`` with ``method`` (its config with ``overrides``, dotted keys) and
+    ``seed`` into ``out``/tracks.csv and ``out``/summary.json, and score it against the
+    recording's ground truth."""
+    from occupose.config import method_config
     from occupose.io.recording import Recording
-    from occupose.tracker import track_recording
+    from occupose.run import track_recording, write_run
 
     rec = Recording(recording)
-    result = track_recording(rec, method, seed=seed, progress=progress, **settings)
-    out.mkdir(parents=True, exist_ok=True)
-    write_tracks_csv(out / "tracks.csv", result.tracks)
-    summary = {"recording": str(rec.path), **result.settings, "frames": result.num_frames,
-               "people": len(result.tracks), "seconds": {k: round(v, 4) for k, v in result.seconds.items()},
-               "fps": round(result.fps, 2)}
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=list) + "\n")
+    config = method_config(method).with_values(overrides or {})
+    result = track_recording(rec, config, seed=seed, progress=progress)
+    write_run(out, result, rec.path, method)
     gt = rec.groundtruth()
     joints = {tid: track[0] for tid, track in result.tracks.items()}
     arms = None
@@ -252,8 +251,10 @@ _progress_queue = None
 def _init_worker(progress_queue, numba_threads: int) -> None:
     """Pool worker set-up: numba's thread count (before numba is imported: this module
     does not import it) and the queue that reports frames done to the parent."""
+    from occupose._numba import configure
+
     global _progress_queue
-    os.environ["NUMBA_NUM_THREADS"] = str(numba_threads)
+    configure(threads=numba_threads)
     _progress_queue = progress_queue
 
 
@@ -266,11 +267,12 @@ def _in_worker(task: Callable, *args, **kwargs):
 
 def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str] | str | None = None,
              runs: int = 3, *, out: str | os.PathLike, frames: int | None = None, procedural: bool = False,
-             jobs: int | None = None, progress: Progress | None = None, **settings) -> Evaluation:
+             jobs: int | None = None, progress: Progress | None = None,
+             overrides: Mapping[str, Any] | None = None) -> Evaluation:
     """Run every method on every scenario ``runs`` times (seeds 0..runs-1) and report.
 
     scenarios : names of occupose.synth.scenarios.SCENARIOS (a list or "a,b"); None: all
-    methods : names of occupose.tracker.METHODS; None: DEFAULT_METHODS
+    methods : names of occupose.config.METHODS; None: DEFAULT_METHODS
     runs : runs per method and scenario, >= 1
     out : folder for recordings/, runs/, results.csv, report.md and the plots
     frames : render and track at most this many frames of each scenario (None: all)
@@ -279,12 +281,12 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
         in this process)
     progress : callable(n, total) after n more frames were rendered or tracked, total
         being all the frames to render and track
-    settings : tracker settings for every method (occupose.tracker.Tracker)
+    overrides : config values for every method, dotted keys (``{"pose.particles": 300}``)
 
     Returns an Evaluation. Raises ValueError for unknown names or bad counts.
     """
     from occupose.synth.scenarios import SCENARIOS, build_scenario
-    from occupose.tracker import METHODS
+    from occupose.config import METHODS
 
     scenarios = _names(scenarios, list(SCENARIOS), list(SCENARIOS), "scenario(s)")
     methods = _names(methods, list(METHODS), DEFAULT_METHODS, "method(s)")
@@ -311,9 +313,9 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
         for scenario, task in renders.items():
             task[0](*task[1:], progress=report)
             for run in runs_of(scenario):
-                results.append(run[0](*run[1:], progress=report, **settings))
+                results.append(run[0](*run[1:], progress=report, overrides=overrides))
     else:
-        results = _in_pool(renders, runs_of, jobs, report, settings)
+        results = _in_pool(renders, runs_of, jobs, report, overrides)
     order = {(s, m): i for i, (s, m) in enumerate((s, m) for s in scenarios for m in methods)}
     results.sort(key=lambda r: (order[r.scenario, r.method], r.seed))
     plots = write_plots(results, out, {s: out / "recordings" / s for s in scenarios})
@@ -324,7 +326,7 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
     return Evaluation(results, report_path, results_path, plots)
 
 
-def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, settings) -> list[RunResult]:
+def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, overrides) -> list[RunResult]:
     """Renders, then each scenario's runs as soon as its recording is there, on ``jobs``
     spawned workers with one numba thread each."""
     context = multiprocessing.get_context("spawn")
@@ -345,7 +347,7 @@ def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, settings) ->
                         results.append(result)
                         continue
                     for run in runs_of(scenario):
-                        pending[pool.submit(_in_worker, *run, **settings)] = None
+                        pending[pool.submit(_in_worker, *run, overrides=overrides)] = None
         except BaseException:
             pool.shutdown(wait=False, cancel_futures=True)
             raise

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from occupose.config import BlobConfig
 from occupose.grid._label_kernels import label_cells
 from occupose.grid.spec import GridSpec
 
@@ -25,10 +26,10 @@ from occupose.grid.spec import GridSpec
 #: person seated behind a table (upper body only, top ~1.3 m) ~150-230, a person under a
 #: ceiling camera ~60-120. A blob must also reach ``min_top`` above the floor and span
 #: ``min_height``; pieces in one column are joined first (``join_m``, see blobs_from_mask).
-MIN_CELLS = 40
-MIN_HEIGHT = 0.3
-MIN_TOP = 0.7
-JOIN_M = 0.1
+MIN_CELLS = BlobConfig.min_cells
+MIN_HEIGHT = BlobConfig.min_height
+MIN_TOP = BlobConfig.min_top
+JOIN_M = BlobConfig.join_m
 
 
 @dataclass(frozen=True, eq=False)

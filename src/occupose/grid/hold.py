@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from occupose.config import GridConfig
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
 from occupose.geometry.primitives import BOX, ROUND_CONE, Primitives
@@ -32,7 +33,7 @@ from occupose.geometry.primitives import BOX, ROUND_CONE, Primitives
 #: Default margin (metres) around each capsule: the half diagonal of a 5 cm cell (a cell
 #: whose centre is that far from the surface can still hold surface points) plus about
 #: 6 cm of prediction error.
-MARGIN = 0.1
+MARGIN = GridConfig.hold_margin
 
 
 def cells_near_capsules(spec: GridSpec, a, b, radii, margin: float = MARGIN) -> np.ndarray:

@@ -110,6 +110,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points
+from occupose.config import GridConfig
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
 from occupose.sensors import depth_std, depth_std_coefficients
@@ -120,10 +121,11 @@ STATE_NAMES = ("O", "M", "E")
 #: Cell visibility from the cameras.
 UNOBSERVED, VISIBLE, HIDDEN = _kernels.UNOBSERVED, _kernels.VISIBLE, _kernels.HIDDEN
 
-ALPHA, BETA, GAMMA, PSI = 0.01, 0.1, 0.4, math.exp(-38.0)
-P_OCC, P_FREE = 0.9, 0.05
-TAIL_WIDTH = 2.0
-INITIAL = (0.4, 0.0, 0.6)
+#: Defaults of the model's parameters: the fields of :class:`occupose.config.GridConfig`.
+ALPHA, BETA, GAMMA, PSI = GridConfig.alpha, GridConfig.beta, GridConfig.gamma, GridConfig.psi
+P_OCC, P_FREE = GridConfig.p_occ, GridConfig.p_free
+TAIL_WIDTH = GridConfig.tail_width
+INITIAL = GridConfig.initial
 #: Noise model for cameras whose intrinsics match no sensor preset (the noisier of the two).
 DEFAULT_NOISE_MODEL = "structured_light"
 #: Far range (metres) for cameras whose intrinsics match no sensor preset.

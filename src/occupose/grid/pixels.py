@@ -26,6 +26,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from occupose.camera import Camera, points_from_depth
+from occupose.config import PixelsConfig
 from occupose.grid.blobs import Blob
 from occupose.grid.occupancy import E, M, cells_from_depth
 from occupose.grid.spec import GridSpec
@@ -35,9 +36,9 @@ DistanceFunction = Callable[[np.ndarray], np.ndarray]
 
 _MAX_TRACKS = 62  # tracks are bits of an int64 code
 #: Default search radius of `distance_to_points`, metres.
-REACH = 0.1
+REACH = PixelsConfig.reach
 #: `predicted_from_tracks` keeps about this many points of each previous observation.
-BODY_POINTS = 4000
+BODY_POINTS = PixelsConfig.body_points
 
 
 def _horizontal(points: np.ndarray, center: np.ndarray) -> np.ndarray:
@@ -58,7 +59,7 @@ FALLBACKS: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {
 
 
 @dataclass(frozen=True, eq=False)
-class Observation:
+class PersonPixels:
     """The depth data of one tracked person in one frame.
 
     track_id : int
@@ -82,7 +83,7 @@ def distance_to_points(reference: np.ndarray, *, reach: float = REACH) -> Distan
     reference : (M, 3) float, metres, world frame, M >= 1 (e.g. a track's last observation)
     reach : float, metres; farther points get ``inf`` (a k-d tree's nearest-neighbour search
         from far off a dense surface visits most of it, so the search stops there), for
-        which `observations_from_depth` uses the track's ``fallback`` distance
+        which `pixels_from_depth` uses the track's ``fallback`` distance
     """
     reference = np.asarray(reference, np.float64)
     if reference.ndim != 2 or reference.shape[1] != 3 or len(reference) == 0:
@@ -123,7 +124,7 @@ def _label_codes(labels: np.ndarray, tracks: Mapping[int, Blob], ids: list[int])
     return codes
 
 
-def observations_from_depth(
+def pixels_from_depth(
     depths: Mapping[str, np.ndarray],
     cameras: Sequence[Camera],
     spec: GridSpec,
@@ -134,7 +135,7 @@ def observations_from_depth(
     centers: Mapping[int, np.ndarray] | None = None,
     predicted: Mapping[int, DistanceFunction] | None = None,
     fallback: str = "horizontal",
-) -> tuple[dict[int, Observation], dict[str, np.ndarray]]:
+) -> tuple[dict[int, PersonPixels], dict[str, np.ndarray]]:
     """Split the depth pixels of one frame among the tracked people.
 
     Parameters
@@ -161,7 +162,7 @@ def observations_from_depth(
 
     Returns
     -------
-    observations : ``{track_id: Observation}`` for every track in ``tracks``
+    observations : ``{track_id: PersonPixels}`` for every track in ``tracks``
     assigned : camera name -> (H, W) int32 image of the track id of each pixel, 0 = nobody
     """
     labels, cameras = _check_inputs(depths, cameras, spec, labels, tracks)
@@ -201,7 +202,7 @@ def observations_from_depth(
             mine = owner == tid
             pixels_of[tid][camera.name] = pixels[mine]
             points_of[tid][camera.name] = points[mine]
-    return {tid: Observation(tid, pixels_of[tid], points_of[tid]) for tid in ids}, assigned
+    return {tid: PersonPixels(tid, pixels_of[tid], points_of[tid]) for tid in ids}, assigned
 
 
 def _distances(points, code, ids, predicted, fallback) -> np.ndarray:
@@ -246,18 +247,19 @@ def _nearest_track(points, cells, code, ids, predicted, fallback, spec: GridSpec
     return owner
 
 
-def predicted_from_tracks(states: Mapping[int, TrackState], previous: Mapping[int, Observation], fps: float,
-                          ids=None) -> dict[int, DistanceFunction]:
+def predicted_from_tracks(states: Mapping[int, TrackState], previous: Mapping[int, PersonPixels], fps: float,
+                          ids=None, *, body_points: int = BODY_POINTS, reach: float = REACH
+                          ) -> dict[int, DistanceFunction]:
     """Predicted bodies made of data, for the exclusion principle before a pose is known.
 
-    Each track's body is its previous observation's points (about `BODY_POINTS` of them)
+    Each track's body is its previous observation's points (about ``body_points`` of them)
     moved by its velocity for one frame, or, for a track without one, the centres of its
     own cells this frame (``TrackState.points``: the tracker's share of any merged blob);
-    distances as `distance_to_points` (``inf`` beyond `REACH`).
+    distances as `distance_to_points` (``inf`` beyond ``reach`` metres).
 
     states : ``BlobTracker.states``; previous : the last frame's observations; fps : float
     ids : track ids to give a body to (default: the tracks seen this frame)
-    Returns ``{track_id: f(points (N, 3)) -> (N,) metres}`` for `observations_from_depth`.
+    Returns ``{track_id: f(points (N, 3)) -> (N,) metres}`` for `pixels_from_depth`.
     """
     fps = float(fps)
     if not (np.isfinite(fps) and fps > 0):
@@ -268,11 +270,11 @@ def predicted_from_tracks(states: Mapping[int, TrackState], previous: Mapping[in
         state = states[tid]
         before = previous.get(tid)
         if before is not None and len(before.points):
-            moved = before.points[::max(1, len(before.points) // BODY_POINTS)].copy()
+            moved = before.points[::max(1, len(before.points) // body_points)].copy()
             moved[:, :2] += state.velocity / fps
-            bodies[tid] = distance_to_points(moved)
+            bodies[tid] = distance_to_points(moved, reach=reach)
         elif len(state.points):
-            bodies[tid] = distance_to_points(state.points)
+            bodies[tid] = distance_to_points(state.points, reach=reach)
     return bodies
 
 

@@ -46,6 +46,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial import cKDTree
 
+from occupose.config import BlobConfig
 from occupose.grid.blobs import Blob, union_of_blobs
 
 _INFEASIBLE = 1e9
@@ -127,7 +128,7 @@ class BlobTracker:
     Parameters
     ----------
     fps : float, frames per second of the updates
-    max_gap_s : float, seconds a track survives without a blob (default 1 s)
+    max_gap_s : float, seconds a track survives without a blob
     gate_m : float, metres, largest horizontal distance between a track's prediction and
         its matched blob's centroid, for a track seen in the previous frame
     gate_growth : float, metres per second of absence added to the gate
@@ -137,13 +138,16 @@ class BlobTracker:
     fragment_m : float, metres, largest horizontal distance from a track's core blob to
         another blob that is a piece of the same person
     min_share : float in [0, 1], least share of a shared blob's cells a track keeps its claim with
-    alpha, beta : float in (0, 1], gains of the alpha-beta filter on the horizontal
-        position and velocity
+    position_gain, velocity_gain : float in (0, 1], the gains (alpha, beta) of the
+        alpha-beta filter on the horizontal position and velocity
+    Defaults: the fields of :class:`occupose.config.BlobConfig`.
     """
 
-    def __init__(self, fps: float, max_gap_s: float = 1.0, *, gate_m: float = 0.5,
-                 gate_growth: float = 1.0, claim_share: float = 0.2, merge_margin_m: float = 0.1,
-                 fragment_m: float = 0.5, min_share: float = 0.1, alpha: float = 0.5, beta: float = 0.1):
+    def __init__(self, fps: float, max_gap_s: float = BlobConfig.max_gap_s, *, gate_m: float = BlobConfig.gate_m,
+                 gate_growth: float = BlobConfig.gate_growth, claim_share: float = BlobConfig.claim_share,
+                 merge_margin_m: float = BlobConfig.merge_margin_m, fragment_m: float = BlobConfig.fragment_m,
+                 min_share: float = BlobConfig.min_share, position_gain: float = BlobConfig.position_gain,
+                 velocity_gain: float = BlobConfig.velocity_gain):
         self.fps = _number(fps, "fps", 0, open_low=True)
         self.max_gap_s = _number(max_gap_s, "max_gap_s", 0)
         self.gate_m = _number(gate_m, "gate_m", 0, open_low=True)
@@ -152,8 +156,8 @@ class BlobTracker:
         self.merge_margin_m = _number(merge_margin_m, "merge_margin_m", 0)
         self.fragment_m = _number(fragment_m, "fragment_m", 0)
         self.min_share = _number(min_share, "min_share", 0, 1)
-        self.alpha = _number(alpha, "alpha", 0, 1, open_low=True)
-        self.beta = _number(beta, "beta", 0, 1, open_low=True)
+        self.position_gain = _number(position_gain, "position_gain", 0, 1, open_low=True)
+        self.velocity_gain = _number(velocity_gain, "velocity_gain", 0, 1, open_low=True)
         self.frame = -1  # number of the last update
         self._tracks: dict[int, _Track] = {}
         self._next_id = 1
@@ -329,7 +333,7 @@ class BlobTracker:
             track.centroid = measured.copy()
         else:
             residual = measured[:2] - track.prediction[:2]
-            track.velocity = track.velocity + self.beta * residual * self.fps / (self.frame - track.last_seen)
-            track.centroid = np.array([*(track.prediction[:2] + self.alpha * residual), measured[2]])
+            track.velocity = track.velocity + self.velocity_gain * residual * self.fps / (self.frame - track.last_seen)
+            track.centroid = np.array([*(track.prediction[:2] + self.position_gain * residual), measured[2]])
         track.hits += 1
         track.last_seen = self.frame

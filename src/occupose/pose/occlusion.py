@@ -32,16 +32,12 @@ import numpy as np
 
 from occupose.body import BodyModel, joints_from_poses, limb_angles
 from occupose.camera import Camera, pixels_from_points
+from occupose.config import OcclusionConfig
 from occupose.joints import JOINT_INDEX
 from occupose.pose.proposals import forward, reach_towards
 
 #: Grid visibility code of a hidden cell (see occupose.grid.occupancy).
 HIDDEN_CELL = 2
-#: Hip flexions and knee bends tried when placing hidden legs (:func:`planted_legs`), radians.
-PLANT_HIP = np.linspace(0.0, 1.8, 19)
-PLANT_KNEE = np.linspace(0.0, 2.2, 23)
-#: A part is hidden behind a measured surface nearer than its sphere by more than this, metres.
-HIDDEN_MARGIN = 0.1
 
 
 def sphere_centres(a: np.ndarray, b: np.ndarray, n: int = 5) -> np.ndarray:
@@ -79,7 +75,8 @@ class OcclusionState:
     """
 
     def __init__(self, part_parents: Sequence[int], part_dofs: Sequence[np.ndarray], num_dofs: int,
-                 resume_frames: int = 10, resume_scale: float = 3.0):
+                 resume_frames: int = OcclusionConfig.resume_frames,
+                 resume_scale: float = OcclusionConfig.resume_scale):
         self.parents = np.asarray(part_parents, int)
         k = len(self.parents)
         if len(part_dofs) != k:
@@ -213,8 +210,8 @@ def joint_parts(model: BodyModel) -> list[np.ndarray]:
 
 def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsule_part: np.ndarray,
                           num_parts: int, depths: Mapping[str, np.ndarray], owners: Mapping[str, np.ndarray],
-                          cameras: Sequence[Camera], track_id: int, n: int = 5,
-                          margin: float = HIDDEN_MARGIN) -> np.ndarray:
+                          cameras: Sequence[Camera], track_id: int, n: int = OcclusionConfig.spheres,
+                          margin: float = OcclusionConfig.margin) -> np.ndarray:
     """Which parts have more than half of their spheres hidden from every camera.
 
     A sphere (``n`` per capsule, along its axis) is hidden from a camera when it projects
@@ -254,7 +251,7 @@ def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsu
 
 
 def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins: Sequence[str] = (),
-                 feet: Mapping[str, np.ndarray] | None = None) -> np.ndarray:
+                 feet: Mapping[str, np.ndarray] | None = None, config: OcclusionConfig | None = None) -> np.ndarray:
     """``pose`` (D,) with the legs of ``sides`` ("left", "right") placed with their feet on
     the floor: hip flexion and knee bend (abduction and rotation 0) that put the ankle at
     the model's ankle height, the least bent such leg, the shin near vertical; for the
@@ -269,11 +266,15 @@ def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins
     the person sits down behind a table (and a shin last seen folded stays folded under a
     thigh that moves on); feet stay on the floor while standing, sitting down and getting
     up, so this is where hidden legs are most likely. A chair's back can hide a leg whose
-    foot shows below it.
+    foot shows below it. The hip flexions and knee bends tried are ``config``'s
+    ``plant_hip_*`` and ``plant_knee_*`` (:class:`occupose.config.OcclusionConfig`).
     """
+    config = OcclusionConfig() if config is None else config
     pose = np.array(pose, float)
     feet = feet or {}
-    grid = np.meshgrid(PLANT_HIP, PLANT_KNEE, indexing="ij")
+    hips = np.linspace(0.0, config.plant_hip_max, config.plant_hip_steps)
+    knees = np.linspace(0.0, config.plant_knee_max, config.plant_knee_steps)
+    grid = np.meshgrid(hips, knees, indexing="ij")
     for side, whole in [(side, True) for side in sides] + [(side, False) for side in shins]:
         dofs = [model.dof_names.index(f"{side}_hip_{n}") for n in ("flex", "abd", "rot")]
         bend = model.dof_names.index(f"{side}_knee")
@@ -284,7 +285,7 @@ def planted_legs(model: BodyModel, pose: np.ndarray, sides: Sequence[str], shins
                                         None, bend=forward(model, pose))
             pose[dofs + [bend]] = limb_angles(model, pose, side, "leg", hip, knee, ankle)
             continue
-        hip, knee = (grid[0].reshape(-1), grid[1].reshape(-1)) if whole else (pose[dofs[0]], PLANT_KNEE)
+        hip, knee = (grid[0].reshape(-1), grid[1].reshape(-1)) if whole else (pose[dofs[0]], knees)
         candidates = np.repeat(pose[None], len(knee), axis=0)
         if whole:
             candidates[:, dofs] = np.stack([hip, np.zeros_like(hip), np.zeros_like(hip)], axis=1)

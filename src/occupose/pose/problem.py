@@ -1,9 +1,10 @@
-"""Stage 3 for one person: a body model, a likelihood and a particle filter, joined.
+"""One person's pose as a particle-filter problem: a body model, a likelihood and the priors.
 
 :class:`PoseProblem` is the filter's view of one person (see
 :class:`occupose.filters.base.Problem`): the model's state space and the log-likelihood of
-poses under the current observation. :class:`PoseEstimator` holds a person's filter across
-frames; the tracker keeps one per track.
+poses under the current observation, with the prior terms (floor, reach, feet, hanging arm,
+walking) added per part. :class:`occupose.pose.estimator.PoseEstimator` holds a person's
+filter across frames.
 """
 
 from __future__ import annotations
@@ -12,52 +13,9 @@ import functools
 
 import numpy as np
 
-from occupose.body import BodyModel, capsules_from_poses, diffusion_scales, joints_from_poses, root_drift
-from occupose.filters import apply_limits, make_filter
+from occupose.body import BodyModel, capsules_from_poses, diffusion_scales
+from occupose.config import PriorConfig
 from occupose.likelihood import Observation, make_likelihood, point_distances
-from occupose.pose.proposals import limb_proposals, mirrored_legs
-
-
-#: Default share of the particles given to each limb proposal (see PoseEstimator).
-PROPOSAL_SHARE = 0.1
-#: The floor term (see PoseProblem): a part whose surface reaches more than FLOOR_SLACK
-#: metres below the floor costs FLOOR_COST nats per metre beyond that. The camera sees the
-#: floor, so a limb pushed through it is "hidden behind the floor" and the depth terms do
-#: not object: without this a leg left with no points of its own sinks into the floor.
-FLOOR_SLACK = 0.03
-FLOOR_COST = 20.0
-#: The reach term (see PoseProblem): a hip higher above the floor than its straight leg
-#: reaches, plus REACH_SLACK metres, costs the root's part REACH_COST nats per metre beyond.
-#: Feet stand on the floor. A leg hidden behind furniture keeps its last configuration and
-#: rides along with the pelvis, so nothing else holds the body down: behind a couch or a
-#: chair the visible trunk, free to slide along its axis, rose 10-25 cm to fit a head
-#: larger than the model's (walk_behind_couch, gesture_behind_chair). A model without legs
-#: (the upper body, from the ceiling, where nothing seen beyond the body holds it down)
-#: costs as much per metre its head's top is above the stature plus REACH_SLACK, once the
-#: stature is known: the slack also covers a stature measured again within the tracker's
-#: STATURE_CHANGE (5 cm), which leaves the model as it is.
-REACH_SLACK = 0.05
-REACH_COST = 50.0
-#: The feet term (see PoseProblem): a shin whose ankle end is more than FOOT_REACH metres
-#: above the floor costs its part FOOT_COST nats per metre beyond. People walk, stand and
-#: sit with their feet near the floor: the ankles of every built-in scene (mocap walks,
-#: waves and gestures, procedural sitting down) stay below 0.22 m, a swinging foot
-#: included. Nothing else held a leg down that found other points to explain: a person
-#: carrying a chair had its leg on the chair's legs for 3-4 s, the ankle 0.4-0.47 m up
-#: (moved_chair).
-FOOT_REACH = 0.30
-FOOT_COST = 20.0
-#: The hanging-arm term (see PoseProblem.resting): an arm of a model with legs that has
-#: fewer than REST_POINTS of the observed points nearest to its capsules under the last
-#: estimate costs its upper arm REST_COST * (1 + cos) / 2 nats, the cosine of the angle
-#: between the upper arm (shoulder to elbow) and the vertical pointing up: 0 hanging,
-#: REST_COST raised. An arm the camera does not see (the far arm of a person seen side-on,
-#: behind the body) costs nothing in the depth terms anywhere behind the body and drifted
-#: there (two_people_crossing, the first person's arm error 9.8 cm against apf's 7.8); a
-#: seen arm's points outweigh the term. Models without legs (seen from above) are left
-#: out: the top views were not evaluated with it.
-REST_POINTS = 15
-REST_COST = 1.0
 
 
 class PoseProblem:
@@ -72,21 +30,24 @@ class PoseProblem:
     part_weights : how the part-based filter weights each of ``model.weight_groups``, a
         key of :data:`PART_WEIGHTS` (see :func:`chain_weight_groups`)
     floor : height of the floor, world metres (DESIGN: z = 0), below which a part costs
-        :data:`FLOOR_COST` nats per metre, and above which a hip cannot be higher than its
-        leg reaches, nor a head without legs higher than the stature once it is known
-        (:func:`add_reach_term`, :attr:`stature_known`), nor an ankle more than
-        :data:`FOOT_REACH` above it (:func:`add_feet_term`); None for no floor
+        (:func:`add_floor_term`), and above which a hip cannot be higher than its leg
+        reaches, nor a head without legs higher than the stature once it is known
+        (:func:`add_reach_term`, :attr:`stature_known`), nor an ankle too high
+        (:func:`add_feet_term`); None for no floor
+    priors : the costs and slacks of those terms and of the hanging-arm term
+        (:class:`occupose.config.PriorConfig`; default its defaults)
     """
 
     def __init__(self, model: BodyModel, likelihood: str = "points+free", *, fps: float = 30.0,
                  diffusion: np.ndarray | None = None, likelihood_options: dict | None = None,
                  stages: list[list[int]] | None = None, part_weights: str = "chain",
-                 floor: float | None = 0.0):
+                 floor: float | None = 0.0, priors: PriorConfig | None = None):
         if part_weights not in PART_WEIGHTS:
             raise ValueError(f"unknown part_weights {part_weights!r}; valid names: {', '.join(PART_WEIGHTS)}")
         if floor is not None and not np.isfinite(floor):
             raise ValueError(f"floor must be a finite height in metres or None, got {floor!r}")
         self.floor = floor
+        self.priors = PriorConfig() if priors is None else priors
         self.model = model
         self.likelihood_name = likelihood
         self.likelihood_options = dict(likelihood_options or {})
@@ -145,11 +106,13 @@ class PoseProblem:
         a, b = capsules_from_poses(self.model, poses)
         out = self._likelihood.evaluate(a, b, self.model.capsule_radii, self.model.capsule_part,
                                         len(self.model.part_names))
+        priors = self.priors
         if self.floor is not None:
-            add_floor_term(self.model, a, b, self.floor, out)
-            add_reach_term(self.model, a, b, self.floor, out, stature_known=self.stature_known)
-            add_feet_term(self.model, b, self.floor, out)
-        add_rest_term(self.model, a, b, self.resting, out)
+            add_floor_term(self.model, a, b, self.floor, out, priors.floor_slack, priors.floor_cost)
+            add_reach_term(self.model, a, b, self.floor, out, priors.reach_slack, priors.reach_cost,
+                           stature_known=self.stature_known)
+            add_feet_term(self.model, b, self.floor, out, priors.foot_reach, priors.foot_cost)
+        add_rest_term(self.model, a, b, self.resting, out, priors.rest_cost)
         if self.walking is not None and self._heading_part is not None:
             direction, weight = self.walking
             out[:, self._heading_part] -= 0.5 * weight * (1.0 - np.cos(poses[:, self.heading_dof] - direction))
@@ -157,39 +120,47 @@ class PoseProblem:
         return out
 
 
-def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray) -> None:
+def add_floor_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray,
+                   slack: float = PriorConfig.floor_slack, cost: float = PriorConfig.floor_cost) -> None:
     """Add the floor term to per-part log-likelihoods ``out`` (P, K), in place: each capsule
-    of ``model`` (ends a, b (P, C, 3) world metres) whose surface reaches more than
-    FLOOR_SLACK below ``floor`` (metres) costs its part FLOOR_COST nats per metre beyond."""
+    of ``model`` (ends a, b (P, C, 3) world metres) whose surface reaches more than ``slack``
+    metres below ``floor`` (metres) costs its part ``cost`` nats per metre beyond. The camera
+    sees the floor, so a limb pushed through it is "hidden behind the floor" and the depth
+    terms do not object (docs/notes: the floor term)."""
     lowest = np.minimum(a[..., 2] - model.capsule_radii[:, 0], b[..., 2] - model.capsule_radii[:, 1])
-    sunk = np.maximum(floor - FLOOR_SLACK - lowest, 0.0)
-    out -= FLOOR_COST * (sunk @ _part_matrix(model))
+    sunk = np.maximum(floor - slack - lowest, 0.0)
+    out -= cost * (sunk @ _part_matrix(model))
 
 
-def add_feet_term(model: BodyModel, b: np.ndarray, floor: float, out: np.ndarray) -> None:
+def add_feet_term(model: BodyModel, b: np.ndarray, floor: float, out: np.ndarray,
+                  reach: float = PriorConfig.foot_reach, cost: float = PriorConfig.foot_cost) -> None:
     """Add the feet term to per-part log-likelihoods ``out`` (P, K), in place, from the
     capsules' ends b (P, C, 3), world metres (a shin's end b is its ankle): each shin of
-    ``model`` whose ankle is more than FOOT_REACH above ``floor`` (metres) costs its part
-    FOOT_COST nats per metre beyond (a model without shins: nothing)."""
+    ``model`` whose ankle is more than ``reach`` metres above ``floor`` (metres) costs its
+    part ``cost`` nats per metre beyond (a model without shins: nothing). People walk, stand
+    and sit with their feet near the floor (docs/notes: the feet term)."""
     shins, parts = _shins(model)
     if len(shins):
-        raised = np.maximum(b[:, shins, 2] - floor - FOOT_REACH, 0.0)
-        out -= FOOT_COST * (raised @ parts)
+        raised = np.maximum(b[:, shins, 2] - floor - reach, 0.0)
+        out -= cost * (raised @ parts)
 
 
-def add_rest_term(model: BodyModel, a: np.ndarray, b: np.ndarray, capsules: np.ndarray, out: np.ndarray) -> None:
+def add_rest_term(model: BodyModel, a: np.ndarray, b: np.ndarray, capsules: np.ndarray, out: np.ndarray,
+                  cost: float = PriorConfig.rest_cost) -> None:
     """Add the hanging-arm term to per-part log-likelihoods ``out`` (P, K), in place: each
     capsule of ``capsules`` (upper arms, indices into the model's capsules; ends a, b
-    (P, C, 3), world metres) costs its part REST_COST * (1 + cos) / 2 nats, the cosine of
-    its axis (a to b) with the vertical pointing up."""
+    (P, C, 3), world metres) costs its part ``cost`` * (1 + cos) / 2 nats, the cosine of
+    its axis (a to b) with the vertical pointing up: 0 hanging, ``cost`` raised. An arm the
+    camera does not see costs nothing in the depth terms anywhere behind the body and
+    drifts there (docs/notes: the hanging-arm term)."""
     for c in capsules:
         axis = b[:, c] - a[:, c]
         up = axis[:, 2] / np.maximum(np.linalg.norm(axis, axis=1), 1e-9)
-        out[:, model.capsule_part[c]] -= REST_COST * 0.5 * (1.0 + up)
+        out[:, model.capsule_part[c]] -= cost * 0.5 * (1.0 + up)
 
 
 def unseen_arms(model: BodyModel, pose: np.ndarray, observation: Observation,
-                min_points: int = REST_POINTS) -> np.ndarray:
+                min_points: int = PriorConfig.rest_points) -> np.ndarray:
     """(A,) int64: the upper-arm capsules of ``model``'s arms (upper arm and forearm) that
     fewer than ``min_points`` of ``observation``'s points are nearest to under ``pose``
     (D,); none for a model without legs or arms."""
@@ -234,12 +205,14 @@ def _part_matrix(model: BodyModel) -> np.ndarray:
     return (model.capsule_part[:, None] == np.arange(len(model.part_names))).astype(np.float64)
 
 
-def add_reach_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray, *,
+def add_reach_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float, out: np.ndarray,
+                   slack: float = PriorConfig.reach_slack, cost: float = PriorConfig.reach_cost, *,
                    stature_known: bool = True) -> None:
     """Add the reach term to per-part log-likelihoods ``out`` (P, K), in place, from the
-    capsule ends a, b (P, C, 3), world metres: the root's part costs REACH_COST nats per
+    capsule ends a, b (P, C, 3), world metres: the root's part costs ``cost`` nats per
     metre that the body reaches higher above ``floor`` than it can standing, plus
-    REACH_SLACK. With legs that is the lower hip (the thighs' top ends) above a straight
+    ``slack`` metres. Feet stand on the floor: a leg hidden behind furniture holds nothing
+    down (docs/notes: the reach term). With legs that is the lower hip (the thighs' top ends) above a straight
     leg's reach (thigh + shin + the shin's bottom radius); without legs (the upper body,
     seen from above) the head's top above the stature (``model.dims.height``), when
     ``stature_known`` (else, or without a head either, nothing)."""
@@ -251,7 +224,7 @@ def add_reach_term(model: BodyModel, a: np.ndarray, b: np.ndarray, floor: float,
     else:
         radii = model.capsule_radii[heads]
         top = np.maximum(a[:, heads, 2] + radii[:, 0], b[:, heads, 2] + radii[:, 1]).max(axis=1)
-    out[:, root_part] -= REACH_COST * np.maximum(top - floor - reach - REACH_SLACK, 0.0)
+    out[:, root_part] -= cost * np.maximum(top - floor - reach - slack, 0.0)
 
 
 @functools.lru_cache(maxsize=64)
@@ -323,96 +296,3 @@ def default_stages(model: BodyModel) -> list[list[int]]:
             if any("thigh" in model.part_names[k] or "shin" in model.part_names[k] for k in p.parts) and i > 0]
     rest = [i for i in range(1, len(model.partitions)) if i not in legs]
     return [group for group in ([0], rest, legs) if group]
-
-
-class PoseEstimator:
-    """A particle filter on one person's pose, stepped frame by frame.
-
-    filter : a name of occupose.filters.FILTERS; particles : number of particles;
-    rng : np.random.Generator; velocity_damping : share of the root's last translation
-    added to every particle before a step (constant-velocity prediction; 0 = none);
-    proposals : share of the particles whose arm or leg tries where the points unexplained
-    by the last estimate suggest, per limb (:func:`occupose.pose.proposals.limb_proposals`), and
-    whose leg tries the other leg's angles for a still person with bent legs
-    (:func:`occupose.pose.proposals.mirrored_legs`; 0 = none); before each step the arms with
-    no points of their own under the last estimate are put under the hanging-arm term
-    (:func:`unseen_arms`, :attr:`PoseProblem.resting`);
-    filter_options : e.g. ``num_layers``
-    """
-
-    def __init__(self, problem: PoseProblem, filter: str, particles: int, rng: np.random.Generator,
-                 velocity_damping: float = 0.8, proposals: float = PROPOSAL_SHARE, **filter_options):
-        if not 0.0 <= proposals < 1.0:
-            raise ValueError(f"proposals (a share of the particles) must be in [0, 1), got {proposals!r}")
-        self.problem = problem
-        self.filter = make_filter(filter, problem, particles, rng, **filter_options)
-        self.velocity_damping = velocity_damping
-        self.proposals = proposals
-        self._has_arms = "left_shoulder_flex" in problem.model.dof_names
-        self._previous = None
-
-    def initialise(self, pose: np.ndarray, spread: float | np.ndarray = 0.0) -> None:
-        """Start from ``pose`` (D,), particles spread by ``spread`` std (scalar or (D,))."""
-        self.filter.initialise(np.asarray(pose, float), spread)
-        self._previous = np.asarray(pose, float).copy()
-
-    def shift(self, offset: np.ndarray) -> None:
-        """Move every particle, the estimate and the velocity memory by ``offset`` (D,), e.g.
-        the root's x, y to where a person reappeared (no velocity is inferred from the jump),
-        then bring them inside the limits (a heading turned by pi wraps)."""
-        offset = np.asarray(offset, float)
-        if offset.shape != (self.problem.num_dofs,):
-            raise ValueError(f"offset must have shape ({self.problem.num_dofs},), got {offset.shape}")
-        limits, angular = self.problem.limits, self.problem.angular
-        self.filter.particles = apply_limits(self.filter.particles + offset, limits, angular)
-        self.filter.estimate = apply_limits((self.filter.estimate + offset)[None], limits, angular)[0]
-        self._previous = self.filter.estimate.copy()
-
-    def step(self, observation: Observation, *, active: np.ndarray | None = None,
-             diffusion_scale: np.ndarray | None = None) -> np.ndarray:
-        """Estimate this frame's pose (D,) from ``observation``; ``active`` (D,) bool freezes
-        the other DOFs, ``diffusion_scale`` (D,) widens the search per DOF."""
-        if active is not None:
-            active = np.asarray(active)
-            if active.shape != (self.problem.num_dofs,) or active.dtype != bool:
-                raise ValueError(f"active must be a ({self.problem.num_dofs},) bool array, got "
-                                 f"{active.dtype} {active.shape}")
-        self.problem.set_observation(observation)
-        current = self.filter.estimate
-        if self.velocity_damping > 0 and current is not None:
-            drift = root_drift(self.problem.model, self._previous, current, self.velocity_damping)
-            if active is not None:
-                drift[~active] = 0.0
-            self.filter.particles = self.filter.particles + drift
-            self._previous = current.copy()
-        if current is not None:
-            self.problem.resting = unseen_arms(self.problem.model, current, observation)
-        if self.proposals > 0 and current is not None:
-            self._propose(current, observation, active)
-        return self.filter.step(active=active, diffusion_scale=diffusion_scale)
-
-    def _propose(self, current: np.ndarray, observation: Observation, active: np.ndarray | None) -> None:
-        """Set the DOFs of a random share of the particles to each limb proposal (models with
-        arms) and to the heading of the way walked, where every DOF set is active, and, for
-        a still person seated or crouching, each leg's active DOFs to the other leg's
-        (:func:`mirrored_legs`)."""
-        model = self.problem.model
-        proposals = limb_proposals(model, current, observation, legs=self.problem.standing,
-                                   floor=self.problem.floor) if self._has_arms else []
-        if self.problem.walking is not None and self.problem.heading_dof is not None:
-            proposals.append((np.array([self.problem.heading_dof]), np.array([self.problem.walking[0]])))
-        proposals = [(dofs, values) for dofs, values in proposals if active is None or active[dofs].all()]
-        if self.problem.standing:
-            proposals += mirrored_legs(model, current, active, self.problem.floor)
-        if not proposals:
-            return
-        count = int(round(self.proposals * self.filter.num_particles))
-        particles = self.filter.particles.copy()
-        for dofs, values in proposals:
-            chosen = self.filter.rng.choice(len(particles), count, replace=False)
-            particles[np.ix_(chosen, dofs)] = values
-        self.filter.particles = particles
-
-    def joints(self, pose: np.ndarray) -> np.ndarray:
-        """(15, 3) canonical joints of ``pose`` (NaN for joints the model does not report)."""
-        return joints_from_poses(self.problem.model, np.asarray(pose, float)[None])[0]

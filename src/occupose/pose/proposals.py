@@ -17,11 +17,14 @@ points better dies at the first resampling.
 Legs the same way, from their feet (:func:`feet`), for a person who stands (a walker's
 foot leaves the floor): a leg behind furniture (a chair's back) whose foot shows below it
 has few points of its own, and drifts where nothing is seen. The unexplained points less
-than :data:`FOOT_HEIGHT` above the floor nearer one hip than the other (across the floor)
-and within reach of it show that leg's foot, and the ankle lies behind the median of
-the foot's points (the toes are ahead of it, and a camera sees the foot's near side): when
-it is more than :data:`FOOT_LOST` from the leg's ankle, the leg reaches it, the knee bent
-forwards.
+than ``foot_height`` above the floor nearer one hip than the other (across the floor) and
+within reach of it show that leg's foot, and the ankle lies behind the median of the
+foot's points (the toes are ahead of it, and a camera sees the foot's near side): when it
+is more than ``foot_lost`` from the leg's ankle, the leg reaches it, the knee bent
+forwards (our legs have no feet, so the toes of a leg in the right place are unexplained
+too: a foot found nearer its ankle is left to the filter).
+
+The settings named here are fields of :class:`occupose.config.ProposalConfig`.
 
 And a still person's legs as each other when they are bent (seated or crouching;
 :func:`mirrored_legs`): a thigh with few points of its own (behind the other leg from one
@@ -34,38 +37,14 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from occupose.body import LIMB_DOFS, BodyModel, capsules_from_poses, joints_from_poses, limb_angles
+from occupose.body import LIMB_DOFS, BodyModel, capsules_from_poses, joints_from_pose, limb_angles
+from occupose.config import ProposalConfig
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation, point_distances
 
-#: Default distance, metres, beyond which a point is not explained by the estimate.
-UNEXPLAINED = 0.05
-#: Default least number of unexplained points that make a limb proposal.
-MIN_POINTS = 10
-#: Reach of an arm beyond its upper arm + forearm (the hand), as a factor.
-REACH = 1.25
-#: Height, metres above the floor, below which unexplained points are taken as a foot.
-FOOT_HEIGHT = 0.2
-#: How far the points of a foot lie ahead of its ankle, metres: a foot's centre (the toes
-#: reach some 0.2 m beyond the ankle, the heel 0.05 m behind it).
-FOOT_AHEAD = 0.07
-#: A foot's points lie within this of their median across the floor, metres.
-FOOT_RADIUS = 0.2
-#: A leg is proposed only when its foot is farther than this from its ankle across the
-#: floor, metres: our legs have no feet, so the toes' points of a leg in the right place are
-#: unexplained too; a foot found nearer its ankle is left to the filter.
-FOOT_LOST = 0.15
 SIDES = ("left", "right")
 #: Joints of each limb from its root: (root, middle, end).
 LIMB_JOINTS = {"arm": ("shoulder", "elbow", "wrist"), "leg": ("hip", "knee", "ankle")}
-#: A still person's legs are proposed as each other when they differ by more than this
-#: in some angle, radians (:func:`mirrored_legs`) ...
-MIRROR_DIFFER = 0.5
-#: ... and the hips are more than this below a straight leg's reach above the floor,
-#: metres (seated or crouching).
-MIRROR_BENT = 0.15
-#: Places tried for the elbow (knee) of a limb that reaches its end within its length.
-ELBOW_CANDIDATES = 8
 
 
 def limb_dofs(model: BodyModel, side: str, limb: str = "arm") -> np.ndarray:
@@ -76,7 +55,7 @@ def limb_dofs(model: BodyModel, side: str, limb: str = "arm") -> np.ndarray:
 
 
 def unexplained_points(model: BodyModel, pose: np.ndarray, observation: Observation,
-                       unexplained: float = UNEXPLAINED) -> np.ndarray:
+                       unexplained: float = ProposalConfig.unexplained) -> np.ndarray:
     """(M, 3) the observation's points farther than ``unexplained`` metres from the surface
     of ``pose`` (D,)."""
     if len(observation.points) == 0:
@@ -87,41 +66,45 @@ def unexplained_points(model: BodyModel, pose: np.ndarray, observation: Observat
 
 
 def limb_proposals(model: BodyModel, pose: np.ndarray, observation: Observation, *, legs: bool = True,
-                   floor: float | None = 0.0, unexplained: float = UNEXPLAINED,
-                   min_points: int = MIN_POINTS) -> list[tuple[np.ndarray, np.ndarray]]:
+                   floor: float | None = 0.0, config: ProposalConfig | None = None
+                   ) -> list[tuple[np.ndarray, np.ndarray]]:
     """The arm and leg poses that the points unexplained by ``pose`` suggest.
 
     model : the body model; pose : (D,) the current estimate; observation : the frame's
     Observation (its points, world metres, and their blocks, shared with the likelihood);
     legs : propose legs too (a model with legs and a ``floor``); floor : its height, metres
+    config : the proposals' settings (default :class:`occupose.config.ProposalConfig`'s)
     Returns a list of (dofs (4,) int64, values (4,) float64), one per limb with evidence.
     """
+    config = ProposalConfig() if config is None else config
     points = observation.points
-    loose = unexplained_points(model, pose, observation, unexplained)
-    if len(loose) < min_points:
+    loose = unexplained_points(model, pose, observation, config.unexplained)
+    if len(loose) < config.min_points:
         return []
-    joints = joints_from_poses(model, pose[None])[0]
-    proposals = _arm_proposals(model, pose, joints, points, loose, min_points)
+    joints = joints_from_pose(model, pose)
+    proposals = _arm_proposals(model, pose, joints, points, loose, config)
     if legs and floor is not None and "left_hip_flex" in model.dof_names:
         viewpoints = np.array([view.camera.position for view in observation.views]).reshape(-1, 3)
-        for side, ankle in feet(model, pose, loose, floor, min_points, points=points, viewpoints=viewpoints).items():
+        for side, ankle in feet(model, pose, loose, floor, points=points, viewpoints=viewpoints,
+                                config=config).items():
             hip, thigh, shin = _limb(joints, side, "leg")
-            if np.linalg.norm(ankle[:2] - joints[JOINT_INDEX[f"{side}_ankle"], :2]) < FOOT_LOST:
+            if np.linalg.norm(ankle[:2] - joints[JOINT_INDEX[f"{side}_ankle"], :2]) < config.foot_lost:
                 continue
-            within = points[np.linalg.norm(points - hip, axis=1) < REACH * (thigh + shin)]
-            knee, ankle = reach_towards(hip, ankle, thigh, shin, within, bend=forward(model, pose))
+            within = points[np.linalg.norm(points - hip, axis=1) < config.reach * (thigh + shin)]
+            knee, ankle = reach_towards(hip, ankle, thigh, shin, within, config.elbow_candidates,
+                                        bend=forward(model, pose))
             proposals.append((limb_dofs(model, side, "leg"), limb_angles(model, pose, side, "leg", hip, knee, ankle)))
     return proposals
 
 
 def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None, floor: float | None, *,
-                  differ: float = MIRROR_DIFFER) -> list[tuple[np.ndarray, np.ndarray]]:
+                  config: ProposalConfig | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """Each leg set as the other one is: its hip flex, abd, rot and knee (the model's DOFs
     mirror left and right) that ``active`` (D,) bool allows (default all; a hidden shin's
     knee is frozen; None: all), when they differ from the other leg's of ``pose`` (D,) by
-    more than ``differ`` radians in some DOF and the hips are more than
-    :data:`MIRROR_BENT` below a straight leg's reach above the ``floor`` (its height,
-    metres; seated or crouching). Returns a list of (dofs (n,) int64, values (n,)
+    more than ``config.mirror_differ`` radians in some DOF and the hips are more than
+    ``config.mirror_bent`` metres below a straight leg's reach above the ``floor`` (its
+    height, metres; seated or crouching). Returns a list of (dofs (n,) int64, values (n,)
     float64), at most one per leg ([] for a model without legs or without a floor).
 
     A thigh with few points of its own (behind the other leg from one camera, behind a
@@ -139,53 +122,57 @@ def mirrored_legs(model: BodyModel, pose: np.ndarray, active: np.ndarray | None,
             raise ValueError(f"active must be a ({model.num_dofs},) bool array, got {active.dtype} {active.shape}")
     if "left_hip_flex" not in model.dof_names or floor is None:
         return []
-    joints = joints_from_poses(model, pose[None])[0]
+    config = ProposalConfig() if config is None else config
+    joints = joints_from_pose(model, pose)
     hips = min(joints[JOINT_INDEX[f"{side}_hip"], 2] for side in SIDES) - floor
-    if hips > model.dims.hip_height - MIRROR_BENT:
+    if hips > model.dims.hip_height - config.mirror_bent:
         return []
     proposals = []
     for side, other in (("left", "right"), ("right", "left")):
         dofs, source = limb_dofs(model, side, "leg"), limb_dofs(model, other, "leg")
         keep = np.ones(len(dofs), bool) if active is None else active[dofs]
-        if keep.any() and np.max(np.abs(pose[dofs[keep]] - pose[source[keep]])) > differ:
+        if keep.any() and np.max(np.abs(pose[dofs[keep]] - pose[source[keep]])) > config.mirror_differ:
             proposals.append((dofs[keep], pose[source[keep]].copy()))
     return proposals
 
 
-def feet(model: BodyModel, pose: np.ndarray, loose: np.ndarray, floor: float,
-         min_points: int = MIN_POINTS, *, points: np.ndarray | None = None,
-         viewpoints: np.ndarray | None = None) -> dict[str, np.ndarray]:
+def feet(model: BodyModel, pose: np.ndarray, loose: np.ndarray, floor: float, *,
+         points: np.ndarray | None = None, viewpoints: np.ndarray | None = None,
+         config: ProposalConfig | None = None) -> dict[str, np.ndarray]:
     """Where the feet that ``loose`` points (M, 3) show put the ankles: side -> (3,) metres.
 
-    A leg's foot is its ``min_points`` or more loose points less than :data:`FOOT_HEIGHT`
-    above ``floor``, nearer its hip than the other across the floor and within reach of it
-    (:data:`REACH` times the leg's length). The loose points of a foot are what ``pose``
+    With ``config`` (:class:`occupose.config.ProposalConfig`, default its defaults): a leg's
+    foot is its ``min_points`` or more loose points less than ``foot_height`` above
+    ``floor``, nearer its hip than the other across the floor and within reach of it
+    (``reach`` times the leg's length). The loose points of a foot are what ``pose``
     leaves unexplained, its toes for a leg in about the right place, so the foot is all of
     ``points`` (N, 3) (the person's, default ``loose``) below that height within
-    :data:`FOOT_RADIUS` across the floor of their median. Its ankle is behind their median:
-    by :data:`FOOT_AHEAD` against the way ``pose`` faces, and by the shin's radius at the
+    ``foot_radius`` across the floor of their median. Its ankle is behind their median:
+    by ``foot_ahead`` against the way ``pose`` faces (the toes reach some 0.2 m beyond the
+    ankle, the heel 0.05 m behind it), and by the shin's radius at the
     ankle away from the nearest of ``viewpoints`` (V, 3) (the cameras' positions, world
     metres: a camera sees the near side of a foot), at the model's ankle height.
     model : a model with legs; pose : (D,) the current estimate.
     """
-    low = loose[loose[:, 2] < floor + FOOT_HEIGHT]
-    if len(low) < min_points:
+    config = ProposalConfig() if config is None else config
+    low = loose[loose[:, 2] < floor + config.foot_height]
+    if len(low) < config.min_points:
         return {}
     points = loose if points is None else points
-    near_floor = points[points[:, 2] < floor + FOOT_HEIGHT]
+    near_floor = points[points[:, 2] < floor + config.foot_height]
     viewpoints = np.zeros((0, 3)) if viewpoints is None else np.asarray(viewpoints, float).reshape(-1, 3)
-    joints = joints_from_poses(model, pose[None])[0]
+    joints = joints_from_pose(model, pose)
     hips = np.array([joints[JOINT_INDEX[f"{side}_hip"]] for side in SIDES])
     nearer = np.argmin(np.linalg.norm(low[:, None, :2] - hips[None, :, :2], axis=2), axis=1)
     found = {}
     for s, side in enumerate(SIDES):
         hip, thigh, shin = _limb(joints, side, "leg")
-        mine = (nearer == s) & (np.linalg.norm(low - hip, axis=1) < REACH * (thigh + shin))
-        if mine.sum() < min_points:
+        mine = (nearer == s) & (np.linalg.norm(low - hip, axis=1) < config.reach * (thigh + shin))
+        if mine.sum() < config.min_points:
             continue
         centre = np.median(low[mine], axis=0)
-        foot = near_floor[np.linalg.norm(near_floor[:, :2] - centre[:2], axis=1) < FOOT_RADIUS]
-        ankle = (np.median(foot, axis=0) if len(foot) else centre) - FOOT_AHEAD * forward(model, pose)
+        foot = near_floor[np.linalg.norm(near_floor[:, :2] - centre[:2], axis=1) < config.foot_radius]
+        ankle = (np.median(foot, axis=0) if len(foot) else centre) - config.foot_ahead * forward(model, pose)
         if len(viewpoints):
             away = ankle[:2] - viewpoints[np.argmin(np.linalg.norm(viewpoints[:, :2] - ankle[:2], axis=1)), :2]
             radius = model.capsule_radii[model.capsule_part == model.part_names.index(f"{side}_shin"), 1].max()
@@ -207,7 +194,7 @@ def _limb(joints: np.ndarray, side: str, limb: str) -> tuple[np.ndarray, float, 
     return root, float(np.linalg.norm(mid - root)), float(np.linalg.norm(end - mid))
 
 
-def _arm_proposals(model, pose, joints, points, loose, min_points):
+def _arm_proposals(model, pose, joints, points, loose, config: ProposalConfig):
     shoulders = np.array([joints[JOINT_INDEX[f"{side}_shoulder"]] for side in SIDES])
     to_shoulder = np.linalg.norm(loose[:, None, :] - shoulders[None], axis=2)  # (M, 2)
     nearer = np.argmin(to_shoulder, axis=1)
@@ -215,19 +202,19 @@ def _arm_proposals(model, pose, joints, points, loose, min_points):
     for s, side in enumerate(SIDES):
         shoulder, upper, fore = _limb(joints, side, "arm")
         reach = to_shoulder[:, s]
-        mine = (nearer == s) & (reach < REACH * (upper + fore)) & (reach > upper)
-        if mine.sum() < min_points:
+        mine = (nearer == s) & (reach < config.reach * (upper + fore)) & (reach > upper)
+        if mine.sum() < config.min_points:
             continue
         mine = np.flatnonzero(mine)
         hand = loose[mine[np.argsort(reach[mine])[int(0.9 * (len(mine) - 1))]]]
-        within = points[np.linalg.norm(points - shoulder, axis=1) < REACH * (upper + fore)]
-        elbow, wrist = reach_towards(shoulder, hand, upper, fore, within)
+        within = points[np.linalg.norm(points - shoulder, axis=1) < config.reach * (upper + fore)]
+        elbow, wrist = reach_towards(shoulder, hand, upper, fore, within, config.elbow_candidates)
         proposals.append((limb_dofs(model, side), limb_angles(model, pose, side, "arm", shoulder, elbow, wrist)))
     return proposals
 
 
 def reach_towards(root: np.ndarray, end: np.ndarray, upper: float, lower: float, points: np.ndarray | None,
-                  candidates: int = ELBOW_CANDIDATES, bend: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                  candidates: int = ProposalConfig.elbow_candidates, bend: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(middle, end) (3,) metres of a limb from ``root`` reaching for ``end``: an arm's
     elbow and wrist from its shoulder, a leg's knee and ankle from its hip.
 

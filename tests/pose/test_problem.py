@@ -27,20 +27,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from occupose.body import body_model, capsules_from_poses, joints_from_poses, pose_from_joints, standing_pose
+from occupose.body import body_model, capsules_from_poses, joints_from_pose, joints_from_poses, pose_from_joints, standing_pose
+from occupose.config import PriorConfig
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
 from occupose.evaluation.metrics import frame_errors, is_fail, joint_errors, table_row
+from occupose.pose.estimator import PoseEstimator
 from occupose.pose.problem import (
-    FLOOR_COST,
-    FLOOR_SLACK,
-    FOOT_COST,
-    FOOT_REACH,
-    REACH_COST,
-    REACH_SLACK,
-    REST_COST,
-    REST_POINTS,
-    PoseEstimator,
     PoseProblem,
     add_feet_term,
     add_reach_term,
@@ -52,6 +45,7 @@ from occupose.synth.generate import UPPER_BODY_PARTS, frames, person_observation
 from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
+PRIORS = PriorConfig()
 NUM_FRAMES = 90  # 3 s at 30 fps: the FAIL rule's 2 s window after its 1 s grace period
 MAX_POINTS = 1000
 ARMS = [JOINT_INDEX[name] for name in ("left_elbow", "left_wrist", "right_elbow", "right_wrist")]
@@ -85,7 +79,8 @@ def _estimator(model_name, gt, filter_name, particles, seed, **options):
 
 def _track(estimator, gt, observations) -> np.ndarray:
     """(T - 1, 15) joint errors, metres, of frames 1.. (frame 0 is the given start pose)."""
-    estimates = [estimator.joints(estimator.step(observation)) for observation in observations[1:]]
+    model = estimator.problem.model
+    estimates = [joints_from_pose(model, estimator.step(observation)) for observation in observations[1:]]
     return joint_errors(gt[1:], np.array(estimates))
 
 
@@ -171,7 +166,7 @@ def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
     # the shins' lowest surface point (the ankle end's sphere), 20 cm lower
     a, b = capsules_from_poses(model, sunk[None])
     lowest = np.minimum(a[0, :, 2] - model.capsule_radii[:, 0], b[0, :, 2] - model.capsule_radii[:, 1])
-    cost = FLOOR_COST * np.maximum(-FLOOR_SLACK - lowest, 0.0)
+    cost = PRIORS.floor_cost * np.maximum(-PRIORS.floor_slack - lowest, 0.0)
     expected = np.bincount(model.capsule_part, weights=cost, minlength=len(model.part_names))
     assert {model.part_names[i] for i in np.flatnonzero(expected)} == {"left_shin", "right_shin"}
     np.testing.assert_allclose(without[1] - values[1], expected, atol=1e-9)
@@ -181,23 +176,23 @@ def test_a_part_through_the_floor_costs_by_how_far_it_sinks(walk):
 
 def test_an_ankle_raised_beyond_a_step_costs_its_shin(walk):
     """The feet term: the walker's right leg lifted forwards (hip flexed 1.6 rad, knee 0.2),
-    its ankle more than 0.5 m above the floor, costs the right shin FOOT_COST per metre above
-    FOOT_REACH and nothing else, measured from the floor's height; walking (a foot swinging
+    its ankle more than 0.5 m above the floor, costs the right shin PRIORS.foot_cost per metre above
+    PRIORS.foot_reach and nothing else, measured from the floor's height; walking (a foot swinging
     0.21 m up), nothing; a model without legs, nothing."""
     model, problem, free, pose = _floor_problems(walk)
     lifted = pose.copy()
     lifted[[model.dof("right_hip_flex"), model.dof("right_knee")]] = 1.6, 0.2
     poses = np.array([pose, lifted])
     ankles = joints_from_poses(model, poses)[:, [JOINT_INDEX["left_ankle"], JOINT_INDEX["right_ankle"]], 2]
-    assert np.all(ankles[0] < FOOT_REACH) and ankles[1, 0] < FOOT_REACH and ankles[1, 1] > FOOT_REACH + 0.2
+    assert np.all(ankles[0] < PRIORS.foot_reach) and ankles[1, 0] < PRIORS.foot_reach and ankles[1, 1] > PRIORS.foot_reach + 0.2
     cost = free.log_likelihood(poses) - problem.log_likelihood(poses)
     expected = np.zeros((2, len(model.part_names)))
-    expected[1, model.part_names.index("right_shin")] = FOOT_COST * (ankles[1, 1] - FOOT_REACH)
+    expected[1, model.part_names.index("right_shin")] = PRIORS.foot_cost * (ankles[1, 1] - PRIORS.foot_reach)
     np.testing.assert_allclose(cost, expected, atol=1e-6)  # joints and capsule ends agree to ~1e-7 m
     # the floor 0.1 m higher: the same ankle is 0.1 m less above it
     raised = np.zeros((2, len(model.part_names)))
     add_feet_term(model, capsules_from_poses(model, poses)[1], 0.1, raised)
-    np.testing.assert_allclose(-raised, expected - FOOT_COST * 0.1 * (expected > 0), atol=1e-6)
+    np.testing.assert_allclose(-raised, expected - PRIORS.foot_cost * 0.1 * (expected > 0), atol=1e-6)
     upper = body_model("upper")
     out = np.zeros((1, len(upper.part_names)))
     add_feet_term(upper, capsules_from_poses(upper, standing_pose(upper, (0.0, 0.0))[None])[1], -1.0, out)
@@ -207,8 +202,8 @@ def test_an_ankle_raised_beyond_a_step_costs_its_shin(walk):
 def test_an_arm_without_points_of_its_own_is_held_hanging(walk):
     """The hanging-arm term: the walker seen whole has points on both arms, so no arm is
     under it; with the left arm's points (those nearest to its capsules) taken out, the
-    left upper arm is, and costs its part 0 hanging, REST_COST / 2 held out level and
-    REST_COST raised straight up; the other parts nothing. The upper body (no legs): none."""
+    left upper arm is, and costs its part 0 hanging, PRIORS.rest_cost / 2 held out level and
+    PRIORS.rest_cost raised straight up; the other parts nothing. The upper body (no legs): none."""
     gt, observations = walk
     model = body_model("full", dims=dims_from_joints(gt))
     pose = pose_from_joints(model, gt[10])
@@ -218,7 +213,7 @@ def test_an_arm_without_points_of_its_own_is_held_hanging(walk):
     left = [model.part_names.index("left_upper_arm"), model.part_names.index("left_forearm")]
     nearest = point_distances(a, b, model.capsule_radii, seen.points)[1][0]
     own = np.isin(model.capsule_part[nearest], left)
-    assert own.sum() >= 3 * REST_POINTS  # the arm is seen
+    assert own.sum() >= 3 * PRIORS.rest_points  # the arm is seen
     armless = Observation(seen.points[~own], seen.views)
     upper_arm = int(np.flatnonzero(model.capsule_part == left[0])[0])
     assert unseen_arms(model, pose, armless).tolist() == [upper_arm]
@@ -229,7 +224,7 @@ def test_an_arm_without_points_of_its_own_is_held_hanging(walk):
     out = np.zeros((3, len(model.part_names)))
     add_rest_term(model, a, b, np.array([upper_arm]), out)
     expected = np.zeros_like(out)
-    expected[:, left[0]] = [0.0, -REST_COST / 2, -REST_COST]
+    expected[:, left[0]] = [0.0, -PRIORS.rest_cost / 2, -PRIORS.rest_cost]
     np.testing.assert_allclose(out, expected, atol=1e-12)
     # a PoseEstimator puts the arms it finds unseen under the term before each step
     estimator = PoseEstimator(PoseProblem(model), "sir", 50, np.random.default_rng(0))
@@ -244,8 +239,8 @@ def test_an_arm_without_points_of_its_own_is_held_hanging(walk):
 
 def test_a_body_reaching_higher_than_it_can_standing_costs_even_with_the_legs_hidden(walk):
     """The reach term: the person of the walk, lifted 20 cm (its feet off the floor), costs
-    its torso REACH_COST per metre its lower hip is above a straight leg's reach plus
-    REACH_SLACK, also when its legs are hidden (they ride along with the pelvis; the foot
+    its torso PRIORS.reach_cost per metre its lower hip is above a straight leg's reach plus
+    PRIORS.reach_slack, also when its legs are hidden (they ride along with the pelvis; the foot
     it swings, lifted beyond a step, costs its shin too while seen: the feet term); standing,
     nothing. The upper body: its head's top above its stature."""
     model, problem, free, pose = _floor_problems(walk)
@@ -257,13 +252,13 @@ def test_a_body_reaching_higher_than_it_can_standing_costs_even_with_the_legs_hi
     thighs = [c for c, k in enumerate(model.capsule_part) if model.part_names[k].endswith("thigh")]
     shin = np.flatnonzero(model.capsule_part == model.part_names.index("left_shin"))[0]
     reach = model.dims.thigh + model.dims.shin + model.capsule_radii[shin, 1]
-    expected = REACH_COST * (a[0, thighs, 2].min() - reach - REACH_SLACK)
-    assert expected > 0.05 * REACH_COST
+    expected = PRIORS.reach_cost * (a[0, thighs, 2].min() - reach - PRIORS.reach_slack)
+    assert expected > 0.05 * PRIORS.reach_cost
     # the swinging foot, lifted too, rises beyond a step: the feet term costs its shin
     ankles = joints_from_poses(model, lifted[None])[0, [JOINT_INDEX["left_ankle"], JOINT_INDEX["right_ankle"]], 2]
     feet = np.zeros(len(model.part_names))
     feet[[model.part_names.index("left_shin"), model.part_names.index("right_shin")]] = \
-        FOOT_COST * np.maximum(ankles - FOOT_REACH, 0.0)
+        PRIORS.foot_cost * np.maximum(ankles - PRIORS.foot_reach, 0.0)
     assert np.count_nonzero(feet) == 1
     for hidden in (False, True):
         legs = np.array(["thigh" in n or "shin" in n for n in model.part_names]) & hidden
@@ -284,7 +279,7 @@ def test_a_body_reaching_higher_than_it_can_standing_costs_even_with_the_legs_hi
     a, b = capsules_from_poses(upper, poses[1:])
     top = np.maximum(a[0, :, 2] + upper.capsule_radii[:, 0], b[0, :, 2] + upper.capsule_radii[:, 1]).max()
     assert top == pytest.approx(upper.dims.height + 0.2, abs=0.01)  # the head's top, the body's highest
-    np.testing.assert_allclose(out[:, root], [0.0, -REACH_COST * (top - upper.dims.height - REACH_SLACK)], atol=1e-9)
+    np.testing.assert_allclose(out[:, root], [0.0, -PRIORS.reach_cost * (top - upper.dims.height - PRIORS.reach_slack)], atol=1e-9)
     assert not np.delete(out, root, axis=1).any()
     unknown = np.zeros_like(out)
     add_reach_term(upper, *capsules_from_poses(upper, poses), 0.0, unknown, stature_known=False)
@@ -399,9 +394,8 @@ def test_active_freezes_dofs_even_with_the_root_velocity(walk):
 
 def test_joints_are_the_model_joints_of_the_pose():
     model = body_model("upper")
-    estimator = PoseEstimator(PoseProblem(model), "sir", 10, np.random.default_rng(0))
     pose = standing_pose(model, (1.0, 2.0), 0.5)
-    joints = estimator.joints(pose)
+    joints = joints_from_pose(model, pose)
     assert joints.shape == (15, 3)
     assert np.array_equal(joints, joints_from_poses(model, pose[None])[0], equal_nan=True)
     assert np.all(np.isnan(joints[JOINT_INDEX["left_knee"]]))

@@ -1,0 +1,400 @@
+"""Stage 3 for one tracked person: its model, filter and occlusion state, and its policies.
+
+A :class:`Person` is made when its blob starts it (:mod:`occupose.pose.start`); each frame
+:meth:`Person.update` runs the occlusion check (its previous estimate moved to the blob's
+new centre of mass), then the filter on the visible subtree, given only its points near
+that predicted body; hidden legs are placed with their feet on the floor, or, standing,
+reach the feet that show. Over its first estimates it measures its stature again and,
+seen from the front, its neck and shoulders, and resizes its model. A person whose torso
+is hidden is suspended: carried on at its walking speed if it walks and is not at the
+image's edge, else moved with its blob; one whose blob is gone is carried too
+(:meth:`Person.carry`); either is placed back when seen again (:meth:`Person.come_back`).
+The settings are the fields of :class:`occupose.config.TrackerConfig` (sections pose,
+carry, shape, size, occlusion, priors, proposals, likelihood, diffusion).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from occupose.body import (
+    BodyModel,
+    body_model,
+    capsules_from_poses,
+    diffusion_scales,
+    joints_from_pose,
+    pose_from_joints,
+    standing_pose,
+)
+from occupose.body.size import breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
+from occupose.camera import Camera
+from occupose.config import TrackerConfig
+from occupose.filters import filter_options
+from occupose.filters.layered import spread_layers
+from occupose.grid.pixels import PersonPixels
+from occupose.grid.tracking import TrackState
+from occupose.likelihood import Observation, observation_from_views, point_distances
+from occupose.pose.estimator import PoseEstimator
+from occupose.pose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
+from occupose.pose.problem import PoseProblem
+from occupose.pose.proposals import feet, unexplained_points
+from occupose.pose.views import at_border, views_from_pixels
+
+
+@dataclass
+class PersonEstimate:
+    """One tracked person in one frame.
+
+    joints : (15, 3) float64, metres, world; NaN for joints the model does not report
+    visible : (15,) bool, the joint was estimated from this frame's data (False: carried
+        from memory while hidden or while the person's blob is gone)
+    """
+
+    joints: np.ndarray
+    visible: np.ndarray
+
+
+class Person:
+    """Stage 3 state of one tracked person: model, filter, occlusion state (module docstring).
+
+    model : its body model (sized at its start); config : the run's settings; fps : frames/s
+    rng : its own random generator; cameras : the recording's cameras
+    backwards : it runs back in time (the look-back, :mod:`occupose.pose.lookback`): it
+        walks the other way, so its walking prior and turn-round test flip
+    """
+
+    def __init__(self, model: BodyModel, config: TrackerConfig, fps: float, rng: np.random.Generator,
+                 cameras: Sequence[Camera], *, backwards: bool = False):
+        self.model = model
+        self.config = config
+        self.cameras = tuple(cameras)
+        self.backwards = backwards
+        pose = config.pose
+        self.problem = PoseProblem(model, pose.likelihood, fps=fps,
+                                   diffusion=diffusion_scales(model, fps, per_kind=dataclasses.asdict(config.diffusion)),
+                                   likelihood_options=config.likelihood.options_for(pose.likelihood),
+                                   part_weights=pose.part_weights, floor=config.priors.floor, priors=config.priors)
+        layers = pose.layers
+        stages = len(self.problem.partitions)
+        if isinstance(layers, tuple) and len(layers) != stages:  # e.g. the upper model: 2 stages
+            layers = spread_layers(sum(layers), stages)  # the same number, from the root down
+        given = {"num_layers": layers, "survival": pose.survival, "resampling": pose.resampling,
+                 "shuffle": pose.shuffle}
+        accepted = filter_options(pose.filter)
+        options = {k: v for k, v in given.items() if k in accepted and v is not None}
+        self.estimator = PoseEstimator(self.problem, pose.filter, pose.particles, rng, pose.velocity_damping,
+                                       pose.proposal_share, proposal_config=config.proposals, **options)
+        self.occlusion = None
+        if config.occlusion.enabled and model.name == "full":  # the upper body is for ceiling cameras,
+            parents, dofs = part_tree(model)  # under which furniture hides no part of it
+            self.occlusion = OcclusionState(parents, dofs, model.num_dofs, config.occlusion.resume_frames,
+                                            config.occlusion.resume_scale)
+        self.joint_parts = joint_parts(model)
+        self.legs = np.array([n.startswith(config.carry.stand_dofs) for n in model.dof_names])  # (D,) bool (carry)
+        self.stance = standing_pose(model)  # (D,) standing at rest, feet under the hips
+        self.pose: np.ndarray | None = None
+        self.centroid: np.ndarray | None = None  # (3,) its blob's centroid when last seen
+        self.anchor = np.zeros(2)  # pelvis x, y minus its blob's centroid x, y at the last estimate
+        self.lost = False  # gone or suspended since the last estimate
+        self.blob = 0  # id of its blob track (a person keeps its id when its blob's changes)
+        self.path: list[np.ndarray] = []  # pelvis x, y of the last carry.frames estimates
+        # (estimate's number, pelvis x, y, its blob's velocity (2,) m/s) of those of them with
+        # every part in view
+        self.clear: list[tuple[int, np.ndarray, np.ndarray]] = []
+        self.walked_on = False  # carried at a walker's speed since the last estimate (come_back)
+        self.part_visible = np.ones(model.num_parts, bool)
+        self.fps = fps
+        self.since_turn = 0  # estimates since the last turn round (face_the_way_walked)
+        self.estimates = 0  # estimates since the start (settle)
+        self.shapes: list[tuple[float, float]] = []  # (neck depth, shoulder breadth) metres (learn_shape)
+        self.shaped = not (config.shape.learn and model.name == "full")  # resized, or never to be
+        self.tops: list[float] = []  # statures measured on its first estimates (learn_stature)
+        self.problem.stature_known = False  # until learn_stature has measured it again
+
+    def update(self, pixels: PersonPixels, depths: Mapping[str, np.ndarray], assigned: Mapping[str, np.ndarray],
+               state: TrackState) -> PersonEstimate:
+        """One frame of a tracked person.
+
+        pixels : its pixels this frame; depths : camera name -> (H, W) float32 metres;
+        assigned : camera name -> (H, W) int32 track id of each pixel; state : its blob's
+        TrackState this frame
+        """
+        config = self.config
+        active = scale = None
+        centroid = np.asarray(state.centroid, float)
+        if self.lost:
+            self.come_back(centroid)
+        moved = self.pose.copy()
+        moved[:2] += centroid[:2] - self.centroid[:2]
+        self.centroid = centroid
+        if self.occlusion is not None:
+            model = self.model
+
+            def hidden(pose):
+                a, b = capsules_from_poses(model, pose[None])
+                return hidden_parts_in_views(a[0], b[0], model.capsule_radii, model.capsule_part, model.num_parts,
+                                             depths, assigned, self.cameras, self.blob, config.occlusion.spheres,
+                                             config.occlusion.margin)
+
+            self.part_visible = self.occlusion.update(moved, hidden)
+            if self.occlusion.suspended:  # kept, not estimated: walks on, or stays with its blob
+                # (at the image's edge it stays with its blob: the camera cannot show it walk on)
+                if (np.hypot(*self.step()) * self.fps > config.carry.walk_from
+                        and not at_border(pixels, self.cameras, config.start.border_px)):
+                    self.carry()
+                else:
+                    self.pose, self.lost = moved, True
+                return self.estimate(False)
+            active, scale = self.occlusion.active_dofs(), self.occlusion.diffusion_scale()
+            self.problem.hidden_parts = ~self.part_visible
+        seen = observation_from_views(views_from_pixels(pixels, depths, self.cameras, self.model, config.pose,
+                                                        self.body_distance(moved)), config.pose.max_points)
+        if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
+            return self.estimate(False)
+        self.problem.walking, self.problem.standing = self.walking(), self.standing()
+        pose = self.estimator.step(seen, active=active, diffusion_scale=scale)
+        if self.occlusion is not None:
+            pose = self._place_hidden_legs(pose, seen)
+        self.settle(pose, state.velocity)
+        self.face_the_way_walked()
+        self.learn_stature(seen)
+        self.learn_shape(seen)
+        return self.estimate(True)
+
+    def _place_hidden_legs(self, pose: np.ndarray, seen: Observation) -> np.ndarray:
+        """The estimate ``pose`` (D,) with hidden parts at their memory, and hidden legs (and
+        hidden shins under seen thighs) placed with their feet on the floor, or, standing,
+        reaching the feet that show (a thigh seen over a hidden shin too: beside a chair's
+        back too few points of a thigh seen hold it)."""
+        self.occlusion.remember(pose)
+        pose = self.occlusion.with_memory(pose)
+        hidden = dict(zip(self.model.part_names, ~self.part_visible))
+        legs = [side for side in ("left", "right") if hidden[f"{side}_thigh"]]
+        shins = [side for side in ("left", "right") if hidden[f"{side}_shin"] and not hidden[f"{side}_thigh"]]
+        if legs or shins:
+            floor = self.problem.floor
+            shown = feet(self.model, pose, unexplained_points(self.model, pose, seen, self.config.proposals.unexplained),
+                         floor, points=seen.points, viewpoints=np.array([c.position for c in self.cameras]),
+                         config=self.config.proposals) if floor is not None and self.problem.standing else {}
+            legs += [side for side in shins if side in shown]
+            shins = [side for side in shins if side not in shown]
+            pose = planted_legs(self.model, pose, legs, shins, shown, self.config.occlusion)
+            self.occlusion.memory = np.where(self.occlusion.active_dofs(), self.occlusion.memory, pose)
+        return pose
+
+    def settle(self, pose: np.ndarray, velocity: np.ndarray) -> None:
+        """Take a new estimate (D,); velocity (2,) m/s: its blob's horizontal velocity."""
+        carry = self.config.carry
+        self.pose = pose
+        anchor = pose[:2] - self.centroid[:2]  # a partly hidden blob's centroid is off: clipped
+        self.anchor = anchor * min(1.0, carry.max_anchor / max(float(np.hypot(*anchor)), 1e-12))
+        self.path = (self.path + [pose[:2].copy()])[-carry.frames:]
+        self.estimates += 1
+        if self.part_visible.all():
+            self.clear = (self.clear + [(self.estimates, pose[:2].copy(), np.array(velocity, float))])[-carry.frames:]
+
+    def face_the_way_walked(self) -> None:
+        """Turn the whole estimate round (heading + pi) when the person has walked faster
+        than ``carry.walking_speed`` (in its first ``carry.start_check_s`` seconds; later
+        ``carry.later_speed``) over the last ``carry.frames`` estimates in a direction more
+        than ``carry.backwards_deg`` from the way it faces, at most once per ``carry.frames``.
+        A body of round cones fits its points about as well facing either way, and the
+        blob's velocity a person starts with can be off (the grid extracts a body over its
+        first frames), so a person may start facing backwards; and an estimate may not
+        follow a person who turns round on the spot. Slower walks count only at the start:
+        later, a person who turns round to sit down still shows the way it came."""
+        carry = self.config.carry
+        self.since_turn += 1
+        if len(self.path) < carry.frames or self.since_turn < carry.frames:
+            return
+        velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps * self._time
+        heading = self.problem.heading_dof
+        facing = self.pose[heading]
+        off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
+        fast = carry.walking_speed if self.estimates <= carry.start_check_s * self.fps else carry.later_speed
+        if np.hypot(*velocity) > fast and abs(off) > np.deg2rad(carry.backwards_deg):
+            turn = np.zeros(self.model.num_dofs)
+            turn[heading] = np.pi
+            self.estimator.shift(turn)
+            self.pose = self.estimator.filter.estimate.copy()
+            self.since_turn = 0
+
+    def learn_shape(self, observation: Observation) -> None:
+        """With ``shape.learn``: measure the neck depth and shoulder breadth
+        (:func:`occupose.body.size.neck_and_shoulders`) in the first of ``observation``'s
+        views that sees this estimate from the front or the back (``shape.frontal_deg``,
+        ``shape.level_deg``; trunk, head and arms in view, upright); with ``shape.frames``
+        measurements, go on with a model of their medians
+        (:func:`occupose.body.size.dims_with_shoulders`; the particles moved so that the
+        estimate keeps its joints)."""
+        shape, size = self.config.shape, self.config.size
+        if self.shaped or abs(self.pose[self.model.dof("trunk_lean")]) > shape.lean:
+            return
+        legs = np.array([name.endswith(("thigh", "shin")) for name in self.model.part_names])
+        if not (self.part_visible | legs).all():
+            return
+        heading = self.pose[self.problem.heading_dof]
+        for view in observation.views:
+            ray = self.pose[:2] - view.camera.position[:2]
+            square = abs(np.cos(heading) * ray[0] + np.sin(heading) * ray[1]) / max(float(np.hypot(*ray)), 1e-9)
+            if view.camera.down_angle > np.deg2rad(shape.level_deg) or square < np.cos(np.deg2rad(shape.frontal_deg)):
+                continue
+            points = view.points
+            measured = neck_and_shoulders(breadth_profile(points, size), size) if len(points) >= size.top_rank \
+                else None
+            if measured is not None:
+                self.shapes.append(measured)
+                break
+        if len(self.shapes) < shape.frames:
+            return
+        depth, breadth = np.median(self.shapes, axis=0)
+        self._resize(dims_with_shoulders(self.model.dims, self.model.girth, depth, breadth, size))
+        self.shaped = True
+
+    def learn_stature(self, observation: Observation) -> None:
+        """Measure the stature again (the top of the person's points, as at the start) on
+        its first ``shape.stature_frames`` estimates with the pelvis upright (at least
+        ``shape.stature_upright`` of the legs' length above the floor); when their median
+        differs from the model's by more than ``shape.stature_change``, go on with the
+        model scaled to it (its proportions kept; the particles moved so that the estimate
+        keeps its joints). Then the stature is known (PoseProblem.stature_known: the upper
+        body's head may not rise above it)."""
+        shape, size = self.config.shape, self.config.size
+        dims = self.model.dims
+        if len(self.tops) >= shape.stature_frames or self.pose[self.model.dof("z")] < shape.stature_upright * dims.hip_height:
+            return
+        points = np.concatenate([view.points for view in observation.views])
+        if len(points) < size.top_rank:
+            return
+        self.tops.append(top_height(points[:, 2], size.top_rank) + size.top_bias)
+        if len(self.tops) == shape.stature_frames:
+            if abs(np.median(self.tops) - dims.height) > shape.stature_change:
+                self._resize(dims.scaled(float(np.clip(np.median(self.tops), 1.0, 2.2))))
+            self.problem.stature_known = True
+
+    def _resize(self, dims) -> None:
+        """Go on with a model of ``dims`` (BodyDims; girth kept), the particles moved so
+        that the estimate keeps its joints."""
+        model = body_model(self.model.name, dims, self.model.girth)
+        pose = pose_from_joints(model, joints_from_pose(self.model, self.pose), refine=False)
+        self.model = model
+        self.problem.resize(model)
+        self.estimator.shift(pose - self.pose)
+        self.pose = pose
+        self.stance = standing_pose(model)
+
+    def walking(self) -> tuple[float, float] | None:
+        """(direction, weight) of PoseProblem.walking: the way the pelvis moved over the last
+        ``carry.walk_frames`` estimates, weighted ``carry.walk_prior`` nats from
+        ``walk_from + walk_ramp`` m/s up (linearly from 0 at ``walk_from``); None when
+        slower or too new."""
+        carry = self.config.carry
+        velocity = self._velocity()
+        speed = 0.0 if velocity is None else float(np.hypot(*velocity))
+        if speed <= carry.walk_from:
+            return None
+        return (float(np.arctan2(velocity[1], velocity[0])),
+                carry.walk_prior * min(1.0, (speed - carry.walk_from) / carry.walk_ramp))
+
+    def standing(self) -> bool:
+        """Whether the pelvis moved at most ``carry.walk_from`` m/s over the last
+        ``carry.walk_frames`` estimates (PoseProblem.standing: the feet are on the floor)."""
+        velocity = self._velocity()
+        return velocity is not None and float(np.hypot(*velocity)) <= self.config.carry.walk_from
+
+    def _velocity(self) -> np.ndarray | None:
+        """(2,) m/s of the pelvis over the last ``carry.walk_frames`` estimates (forward in
+        time, also for a person run backwards); None for fewer."""
+        frames = self.config.carry.walk_frames
+        if len(self.path) < frames:
+            return None
+        return (self.path[-1] - self.path[-frames]) / (frames - 1) * self.fps * self._time
+
+    @property
+    def _time(self) -> float:
+        """-1 for a person run back in time (its path goes the way it walked from), else 1."""
+        return -1.0 if self.backwards else 1.0
+
+    def step(self) -> np.ndarray:
+        """(2,) metres per frame: the faster of two measures of its walk over its last
+        ``carry.frames`` estimates with every part in view, when there are two of them: their
+        mean step (from the first to the last; they need not follow one another) and their
+        blob's median velocity; else the pelvis's mean step over its last ``carry.frames``
+        estimates; at most ``carry.max_speed``. A person walking behind a cabinet is
+        estimated on what is left in view, which stalls at the cabinet's edge, so those last
+        estimates fall behind; the blob's velocity, smoothed by the blob tracker, lags a
+        person speeding up; each measure falls short where the other does not, and the
+        median leaves out the frames where the blob was already being cut."""
+        carry = self.config.carry
+        recent = [(n, xy, velocity) for n, xy, velocity in self.clear if n > self.estimates - carry.frames]
+        if len(recent) > 1:
+            (first, start, _), (last, end, _) = recent[0], recent[-1]
+            walked = (end - start) / (last - first)
+            blob = np.median([velocity for _, _, velocity in recent], axis=0) / self.fps
+            step = max(walked, blob, key=lambda s: float(np.hypot(*s)))
+        elif len(self.path) > 1:
+            step = (self.path[-1] - self.path[0]) / (len(self.path) - 1)
+        else:
+            return np.zeros(2)
+        return step * min(1.0, carry.max_speed / max(float(np.hypot(*step)), 1e-12))
+
+    def carry(self) -> None:
+        """A frame without an estimate (gone or suspended): the pose walks on at :meth:`step`;
+        at a walker's speed (above ``carry.walk_from``) it comes back where it was carried to
+        (:meth:`come_back`), and its legs (``carry.stand_dofs``, and their occlusion memory)
+        stand, the feet under the hips: a stride frozen while the walk goes on out of sight
+        is a whole step off at every other step, where the middle of a gait cycle is at most
+        half a step off."""
+        step = self.step()
+        self.pose = self.pose.copy()
+        self.pose[:2] += step
+        self.lost = True
+        self.walked_on = float(np.hypot(*step)) * self.fps > self.config.carry.walk_from
+        if self.walked_on:
+            self.pose[self.legs] = self.stance[self.legs]
+            if self.occlusion is not None:
+                self.occlusion.memory[self.legs] = self.stance[self.legs]
+
+    def come_back(self, centroid: np.ndarray) -> None:
+        """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
+        plus the anchor, or where it was carried to if it was carried at a walker's speed
+        (:meth:`carry`: the centroid of a body coming out from behind a cabinet lags at the
+        cabinet's edge, whether its blob was kept or had gone). The particles are where the
+        last estimate left them, not where the pose was carried since, so they are shifted
+        from the estimate (the root's x, y, and the legs when they came to stand). The paths
+        are moved along (the jump onto the blob is no step of the person's): the way it
+        walked before goes on, so a person hidden again soon after is carried on that way."""
+        place = self.pose[:2] if self.walked_on else centroid[:2] + self.anchor
+        offset = np.zeros(self.model.num_dofs)
+        offset[:2] = place - self.estimator.filter.estimate[:2]
+        if self.walked_on:
+            offset[self.legs] = (self.pose - self.estimator.filter.estimate)[self.legs]
+        self.estimator.shift(offset)
+        self.pose = self.pose.copy()
+        self.pose[:2] = place
+        self.centroid, self.lost, self.walked_on = centroid, False, False
+        if self.path:
+            moved = self.pose[:2] - self.path[-1]
+            self.path = [p + moved for p in self.path]
+            self.clear = [(n, p + moved, v) for n, p, v in self.clear]
+
+    def estimate(self, fresh: bool) -> PersonEstimate:
+        """This frame's joints; ``fresh``: estimated from this frame's data (else carried)."""
+        joints = joints_from_pose(self.model, self.pose)
+        visible = np.array([fresh and bool(len(p)) and bool(self.part_visible[p].all()) for p in self.joint_parts])
+        return PersonEstimate(joints, visible & np.isfinite(joints[:, 0]))
+
+    def body_distance(self, pose: np.ndarray | None = None):
+        """f(points (N, 3)) -> (N,) metres to the surface of this person's body in ``pose``
+        (D,) (default: its current pose)."""
+        a, b = capsules_from_poses(self.model, (self.pose if pose is None else pose)[None])
+        radii = self.model.capsule_radii
+
+        def distance(points: np.ndarray) -> np.ndarray:
+            return point_distances(a, b, radii, points, sort=False)[0][0].astype(np.float64)
+
+        return distance

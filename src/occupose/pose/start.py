@@ -1,0 +1,138 @@
+"""When a blob starts a person, and the pose it starts in.
+
+A blob starts a person once its own points (the pixels given to it, not those of the
+people beside it) have been person-like for ``start.frames`` frames in a row: tall enough
+(``start.min_top``), enough of them (``start.min_points``), fully in view of some camera
+(:func:`occupose.pose.views.at_border`) and seen by some camera as a solid silhouette
+(:func:`silhouette_fill`; a wall's scattered readings in a person's shadow from a second
+camera are not). Its body size is measured on those frames' points pooled, and the start
+pose is the best of :func:`start_candidates` (standing and seated, at the headings of
+:func:`start_headings`) and of random perturbations of them, settled by a few filter
+steps. The settings are the fields of :class:`occupose.config.StartConfig`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from occupose.body import BodyModel, body_model, dims_from_observation, pose_from_joints
+from occupose.body.size import top_height
+from occupose.camera import Camera
+from occupose.config import StartConfig, TrackerConfig
+from occupose.grid.pixels import PersonPixels
+from occupose.likelihood import observation_from_views
+from occupose.pose.person import Person
+from occupose.pose.views import at_border, views_from_pixels
+from occupose.synth import motion as procedural
+
+
+def person_like(pixels: PersonPixels, cameras: Sequence[Camera], config: StartConfig, top_rank: int) -> bool:
+    """Whether a blob's own pixels may start a person this frame (the module docstring);
+    ``top_rank`` : the rank of the point taken as the top (:class:`occupose.config.SizeConfig`)."""
+    points = pixels.points
+    return (len(points) >= config.min_points and top_height(points[:, 2], top_rank) >= config.min_top
+            and not at_border(pixels, cameras, config.border_px)
+            and max(silhouette_fill(pixels.pixels[c.name], c.width, config.fill_quantiles) for c in cameras)
+            >= config.min_fill)
+
+
+def silhouette_fill(pixels: np.ndarray, width: int, quantiles: tuple[float, float] = StartConfig.fill_quantiles
+                    ) -> float:
+    """Share of the image box between the ``quantiles`` (percent) of the pixels' columns and
+    rows that the pixels fill (0 for none). A person fills 0.55-0.8 of it (0.12 while cut by
+    the image's edge); a wall's noisy readings in a person's shadow scatter over 0.01-0.08.
+
+    pixels : (N,) int, flat indices ``v * width + u`` of one camera's pixels, distinct
+    """
+    if len(pixels) == 0:
+        return 0.0
+    rows, columns = np.divmod(np.asarray(pixels), width)
+    (u0, u1), (v0, v1) = np.percentile(columns, quantiles), np.percentile(rows, quantiles)
+    inside = (columns >= u0) & (columns <= u1) & (rows >= v0) & (rows <= v1)
+    return float(np.count_nonzero(inside) / ((np.floor(u1) - np.ceil(u0) + 1) * (np.floor(v1) - np.ceil(v0) + 1)))
+
+
+def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera, count: int = StartConfig.headings,
+                   walking_speed: float = 0.3) -> np.ndarray:
+    """The headings of ``count`` around the circle a person may start with, radians: those
+    within 90 degrees of where they walk (``velocity`` (2,) m/s, when faster than
+    ``walking_speed`` m/s), else of the direction towards ``camera`` from ``centroid`` (3,)
+    metres.
+
+    A body of round cones fits its points about as well facing either way (front and
+    back differ little in depth), so the likelihood alone picks the wrong half turn about
+    as often as the right one, which swaps left and right for good; people mostly face
+    where they walk, and a person standing in view of a camera more often faces it.
+    """
+    headings = np.linspace(-np.pi, np.pi, count, endpoint=False)
+    if np.hypot(*velocity) > walking_speed:
+        facing = np.arctan2(velocity[1], velocity[0])
+    else:
+        to_camera = camera.world_from_camera[:2, 3] - centroid[:2]
+        facing = np.arctan2(to_camera[1], to_camera[0])
+    off = (headings - facing + np.pi) % (2 * np.pi) - np.pi
+    return headings[np.abs(off) < np.pi / 2 + 1e-9]
+
+
+def start_candidates(model: BodyModel, centroid: np.ndarray, headings: np.ndarray,
+                     seat_share: float = StartConfig.seat_share) -> np.ndarray:
+    """(S, D) start poses for a person whose blob is centred at ``centroid`` (3,) metres:
+    standing and (for models with legs) sitting on a seat ``seat_share`` of the stature
+    high, at every heading of ``headings`` (radians), the pelvis above the centroid."""
+    poses = []
+    postures = [procedural.standing_pose((0.0, 0.0), 0.0, model.dims)]
+    if any("knee" in n for n in model.dof_names):
+        standing = postures[0]
+        postures.append(procedural.sit_down(standing, seat_share * model.dims.height, dims=model.dims)[-1])
+    for posture in postures:
+        fitted = pose_from_joints(model, procedural.joints_from_pose(posture[None], model.dims)[0])
+        for heading in headings:
+            pose = fitted.copy()
+            pose[model.dof_names.index("heading")] = heading
+            poses.append(pose)
+    poses = np.array(poses)
+    poses[:, 0:2] = centroid[:2]  # pelvis above the blob's centre; the filter settles the rest
+    return poses
+
+
+def start_spread(model: BodyModel, config: StartConfig) -> np.ndarray:
+    """(D,) spread (std) of a new person's particles around its start: ``spread_position``
+    metres on the root's x, y, z, ``spread_heading`` on the heading, ``spread_angle`` on
+    every other angle, radians."""
+    spread = np.where(model.angular, config.spread_angle, config.spread_position)
+    spread[model.dof_names.index("heading")] = config.spread_heading
+    return spread
+
+
+def start_person(points: np.ndarray, pixels: PersonPixels, depths: Mapping[str, np.ndarray], centroid: np.ndarray,
+                 velocity: np.ndarray, cameras: Sequence[Camera], model_name: str, config: TrackerConfig, fps: float,
+                 rng: np.random.Generator) -> Person:
+    """A new person from its blob's pooled points (N, 3) world metres (its size) and this
+    frame's ``pixels``: the best start candidate, settled by ``start.steps`` filter steps.
+
+    depths : camera name -> (H, W) float32 metres; centroid : (3,) metres, the blob's
+    centroid this frame; velocity : (2,) m/s, its track's horizontal velocity;
+    model_name : "full" or "upper"; rng : the person's random generator
+    """
+    size = dims_from_observation(points, size=config.size)
+    person = Person(body_model(model_name, size.dims, size.girth), config, fps, rng, cameras)
+    seen = observation_from_views(views_from_pixels(pixels, depths, cameras, person.model, config.pose),
+                                  config.pose.max_points)
+    problem = person.problem
+    problem.set_observation(seen)
+    centre = np.mean(pixels.points, axis=0)
+    headings = start_headings(velocity, centre, cameras[0], config.start.headings, config.carry.walking_speed)
+    candidates = start_candidates(person.model, centre, headings, config.start.seat_share)
+    spread = start_spread(person.model, config.start)
+    samples = np.repeat(candidates, config.start.samples, axis=0)
+    samples += rng.standard_normal(samples.shape) * spread
+    samples = np.clip(samples, problem.limits[:, 0], problem.limits[:, 1])
+    best = samples[int(np.argmax(problem.log_likelihood(samples).sum(axis=1)))]
+    person.estimator.initialise(best, spread)
+    for _ in range(config.start.steps):
+        best = person.estimator.step(seen)
+    person.centroid = np.asarray(centroid, float)
+    person.settle(best, velocity)
+    return person

@@ -1,0 +1,136 @@
+"""Tracking a whole recording: frames in, every track's joints out, and a run's files.
+
+:func:`track_recording` runs a :class:`occupose.tracker.Tracker` over a recording and
+returns a :class:`TrackingResult`; :func:`write_run` writes it as ``tracks.csv`` and
+``summary.json`` (the resolved config included, so a run's output says everything that
+shaped it). :func:`track_frames` is the loop itself, for frames from anywhere.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from occupose.config import TrackerConfig, method_config
+from occupose.joints import NUM_JOINTS
+from occupose.tracker import STAGES, Tracker
+
+
+@dataclass
+class TrackingResult:
+    """The output of :func:`track_frames` and :func:`track_recording`.
+
+    tracks : {track id: (joints (T, 15, 3) float64 metres, NaN where not tracked,
+        visible (T, 15) bool)}
+    seconds : seconds spent per stage (grid, blobs, observations, pose) and ``total``
+        (all frames, reading excluded), ``startup`` (first frame, numba compilation included)
+    fps : frames per second of tracking, the first frame (start-up) excluded
+    num_frames : frames tracked
+    config : the settings of the run; seed : its seed; model : the body model it used
+    """
+
+    tracks: dict[int, tuple[np.ndarray, np.ndarray]]
+    seconds: dict[str, float] = field(default_factory=dict)
+    fps: float = 0.0
+    num_frames: int = 0
+    config: TrackerConfig = field(default_factory=TrackerConfig)
+    seed: int = 0
+    model: str = ""
+
+
+def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: Callable[[int], None] | None = None,
+                 overlap: bool = False) -> TrackingResult:
+    """Run ``tracker`` over ``frames`` (an iterable of objects with ``.index`` and
+    ``.depth``, e.g. ``Recording.frames()``, indices from 0), the first ``num_frames`` of
+    them. ``progress`` : callable(n) called after each frame, or None. ``overlap`` : update
+    the grid with the next frame while the pose stage works on the current one
+    (:meth:`Tracker.update`'s ``upcoming``)."""
+    joints = {}
+    visible = {}
+    seconds = dict.fromkeys(STAGES, 0.0)
+    startup = 0.0
+    total = 0.0
+    frames = itertools.islice(frames, num_frames)
+    upcoming = next(frames, None)
+    indices = []  # of the frames taken so far
+    while upcoming is not None:
+        frame, upcoming = upcoming, next(frames, None)
+        indices.append(frame.index)
+        start = time.perf_counter()
+        result = tracker.update(frame.depth, upcoming.depth if overlap and upcoming is not None else None)
+        spent = time.perf_counter() - start
+        if len(indices) == 1:
+            startup = spent
+        else:
+            total += spent
+        for stage, value in result.seconds.items():
+            seconds[stage] += value
+        found = [(tid, frame.index, est) for tid, est in result.estimates.items()]
+        found += [(tid, indices[-1 - ago], est) for tid, earlier in result.looked_back.items() for ago, est in earlier]
+        for tid, index, est in found:
+            if tid not in joints:
+                joints[tid] = np.full((num_frames, NUM_JOINTS, 3), np.nan)
+                visible[tid] = np.zeros((num_frames, NUM_JOINTS), bool)
+            joints[tid][index] = est.joints
+            visible[tid][index] = est.visible
+        if progress is not None:
+            progress(1)
+    tracker.close()
+    fps = (num_frames - 1) / total if num_frames > 1 and total > 0 else 0.0
+    return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, dict(seconds, total=total,
+                          startup=startup), fps, num_frames, tracker.config, 0, tracker.model_name)
+
+
+def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: int = 0,
+                    progress: Callable[[int], None] | None = None, overlap: bool = False) -> TrackingResult:
+    """Track every person of a recording.
+
+    recording : an :class:`occupose.io.recording.Recording` or the path of a recording folder
+    config : a TrackerConfig or a method name (:data:`occupose.config.METHODS`)
+    seed : the run's seed; progress : callable(n) after each frame, or None
+    overlap : as :func:`track_frames`; off by default: on an idle 2-core machine the grid's
+        thread competes with the likelihood kernels' two threads (benchmarks/bench_speed.py)
+    An empty recording (no frames) gives an empty result.
+    """
+    from occupose.io.recording import Recording
+
+    if isinstance(recording, (str, os.PathLike)):
+        recording = Recording(recording)
+    if not isinstance(recording, Recording):
+        raise ValueError(f"recording must be a Recording or the path of a recording folder, got "
+                         f"{type(recording).__name__}")
+    config = method_config(config) if isinstance(config, str) else config
+    tracker = Tracker(recording.cameras, recording.fps, config, seed=seed)
+    result = track_frames(tracker, recording.frames(), recording.num_frames, progress, overlap=overlap)
+    result.seed = seed
+    return result
+
+
+def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:
+    """The ``summary.json`` of a run: the recording, the method's name (if it was run as
+    one), seed, body model, the whole resolved config, frames, people, seconds per stage
+    and frames/s (start-up excluded)."""
+    return {"recording": str(recording_path), "method": method, "seed": result.seed, "model": result.model,
+            "config": result.config.to_dict(), "frames": result.num_frames, "people": len(result.tracks),
+            "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
+
+
+def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: str | os.PathLike,
+              method: str | None = None) -> Path:
+    """Write ``out``/tracks.csv and ``out``/summary.json (:func:`summary_of`); returns the
+    tracks.csv path. ``out`` is made if it does not exist."""
+    from occupose.evaluation.metrics import write_tracks_csv
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    tracks_path = out / "tracks.csv"
+    write_tracks_csv(tracks_path, result.tracks)
+    (out / "summary.json").write_text(json.dumps(summary_of(result, recording_path, method), indent=2) + "\n")
+    return tracks_path

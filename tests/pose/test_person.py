@@ -1,0 +1,153 @@
+"""A tracked person's policies: facing the way walked, carrying out of sight, coming back."""
+
+import numpy as np
+import pytest
+
+from occupose.body import body_model, standing_pose
+from occupose.config import CarryConfig, TrackerConfig
+from occupose.pose.person import Person
+
+CARRY = CarryConfig()
+
+
+def _person(model, **kw):
+    return Person(model, TrackerConfig(), 30.0, np.random.default_rng(0), (), **kw)
+
+
+def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
+    person = _person(body_model("full"))
+    assert person.walking() is None and not person.standing()  # no path yet: neither
+    person.path = [np.array([0.0, 0.04 * i]) for i in range(CARRY.walk_frames)]  # 1.2 m/s along +y
+    direction, weight = person.walking()
+    assert direction == pytest.approx(np.pi / 2) and weight == pytest.approx(CARRY.walk_prior)
+    assert not person.standing()
+    person.path = [np.array([-0.02 * i, 0.0]) for i in range(CARRY.walk_frames)]  # 0.6 m/s along -x
+    direction, weight = person.walking()
+    assert abs(direction) == pytest.approx(np.pi) and weight == pytest.approx(CARRY.walk_prior * (0.6 - CARRY.walk_from) / CARRY.walk_ramp)
+    person.path = [np.array([0.01 * i, 0.0]) for i in range(CARRY.walk_frames)]  # 0.3 m/s: standing, swaying
+    assert person.walking() is None and person.standing()
+
+
+def test_a_person_run_backwards_faces_the_way_its_path_comes_from():
+    """Run back in time (the look-back, occupose.pose.lookback), a person's path goes the way it walked from:
+    its walking prior points the other way, and it is turned round when its path goes the
+    way it faces."""
+    model = body_model("full")
+    person = _person(model, backwards=True)
+    person.path = [np.array([0.0, 0.04 * i]) for i in range(CARRY.walk_frames)]  # +y back in time
+    direction, weight = person.walking()
+    assert direction == pytest.approx(-np.pi / 2) and weight == pytest.approx(CARRY.walk_prior)
+    pose = standing_pose(model, (0.0, 0.0), np.pi / 2)  # facing +y
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.estimates, person.since_turn = pose, 10, CARRY.frames
+    person.face_the_way_walked()
+    assert person.pose[model.dof_names.index("heading")] == pytest.approx(-np.pi / 2)
+
+
+@pytest.mark.parametrize("speed, estimates, turned", [(1.2, 100, True), (0.5, 100, False), (0.5, 10, True)])
+def test_a_person_walking_backwards_is_turned_round_at_the_start_or_when_walking_fast(speed, estimates, turned):
+    """The estimate faces +x while the path goes along -x: turned round (heading + pi) at
+    a walk above CARRY.walking_speed in the first CARRY.start_check_s seconds, later only above
+    CARRY.later_speed (a person turning to sit down still shows the way it came)."""
+    assert CARRY.walking_speed < 0.5 < CARRY.later_speed < 1.2 and 10 <= CARRY.start_check_s * 30 < 100
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.estimates, person.since_turn = pose, estimates, CARRY.frames
+    person.path = [np.array([-speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)]
+    person.face_the_way_walked()
+    heading = person.pose[model.dof_names.index("heading")]
+    assert abs(abs(heading) - np.pi) < 1e-9 if turned else heading == 0.0
+
+
+def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.centroid = pose, np.array([0.0, 0.0, 1.0])
+    person.path = [np.array([0.04 * i, 0.0]) for i in range(CARRY.walk_frames)]  # 1.2 m/s along +x
+    person.lost = True
+    person.come_back(np.array([2.0, 1.0, 1.0]))  # back at another blob after a gap
+    assert not person.lost
+    np.testing.assert_allclose(person.pose[:2], [2.0, 1.0])
+    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [2.0, 1.0])
+    np.testing.assert_allclose(person.path[-1], [2.0, 1.0])  # the jump is no step: same way, same speed
+    direction, weight = person.walking()
+    assert direction == pytest.approx(0.0) and weight == pytest.approx(CARRY.walk_prior)
+    person.carry()  # hidden again at once: carried on along +x
+    np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])
+
+
+@pytest.mark.parametrize("speed", [1.2, 0.3])
+def test_a_person_carried_out_of_sight_at_a_walk_stands_its_legs(speed):
+    """Carried at a walker's speed (above CARRY.walk_from), the legs' DOFs, and their occlusion
+    memory, take the standing pose's (the middle of a gait cycle), the trunk, head and arms
+    kept; coming back, the particles follow. Carried standing, nothing but the root's x, y
+    moves."""
+    model = body_model("full")
+    person = _person(model)
+    stride = standing_pose(model, (0.0, 0.0), 0.0)
+    for name, angle in (("left_hip_flex", 0.4), ("right_hip_flex", -0.3), ("right_knee", 0.6),
+                        ("left_shoulder_flex", -0.3), ("right_elbow", 0.5), ("trunk_lean", 0.1)):
+        stride[model.dof(name)] = angle
+    person.estimator.initialise(stride, 0.0)
+    person.pose, person.centroid = stride.copy(), np.array([0.0, 0.0, 1.0])
+    person.occlusion.memory = stride.copy()
+    person.path = [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)]
+    person.carry()
+    legs = np.array([n.startswith(CARRY.stand_dofs) for n in model.dof_names])
+    assert legs.sum() == 8 and person.walked_on == (speed > CARRY.walk_from)
+    rest = standing_pose(model) if person.walked_on else stride
+    np.testing.assert_allclose(person.pose[legs], rest[legs])
+    np.testing.assert_allclose(person.occlusion.memory[legs], rest[legs])
+    np.testing.assert_allclose(person.pose[2:][~legs[2:]], stride[2:][~legs[2:]])  # z, heading, trunk, head, arms
+    person.come_back(np.array([0.5, 0.0, 1.0]))
+    np.testing.assert_allclose(person.estimator.filter.particles[:, legs],
+                               np.broadcast_to(rest[legs], (len(person.estimator.filter.particles), 8)), atol=1e-12)
+    np.testing.assert_allclose(person.estimator.filter.estimate, person.pose, atol=1e-12)
+
+
+def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view():
+    """The estimates of a person walking into occlusion stall at the cabinet's edge: the
+    carry takes its step from the last estimates with every part in view (while they are
+    recent): their mean step or their blob's median velocity (the first frames of the blob
+    being cut do not count), whichever is faster; a person suspended on its blob while
+    walking comes back where it was carried to, not at its blob's centroid (which stays at
+    the edge). The estimates in full view need not follow one another."""
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.centroid = np.array([0.0, 0.0, 1.0])
+    shin = model.part_names.index("right_shin")
+    for i in range(10):  # in full view, the blob at 1.2 m/s along +x (the last two: being cut),
+        person.part_visible[shin] = i not in (4, 5)  # but for a shin counted hidden twice; the
+        blob = [1.2, 0.0] if i < 8 else [0.7, 0.1]  # estimates lag, at 0.6 m/s
+        person.settle(pose + np.eye(model.num_dofs)[0] * 0.02 * i, np.array(blob))
+    person.part_visible[shin] = False
+    for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s, the blob stalls
+        person.settle(pose + np.eye(model.num_dofs)[0] * (0.18 + 0.01 * (i + 1)), np.array([0.2, 0.0]))
+    np.testing.assert_allclose(person.step(), [0.04, 0.0])
+    person.carry()
+    np.testing.assert_allclose(person.pose[:2], [0.27, 0.0])
+    assert person.walked_on  # carried at 1.2 m/s: it comes back there, not on its blob
+    person.come_back(np.array([0.9, 0.3, 1.0]))
+    np.testing.assert_allclose(person.pose[:2], [0.27, 0.0])
+    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [0.27, 0.0])
+    assert not person.walked_on and not person.lost
+    for _ in range(CARRY.frames):  # standing partly hidden for long: its own recent path again
+        person.settle(person.pose, np.array([0.3, 0.0]))
+    np.testing.assert_allclose(person.step(), [0.0, 0.0], atol=1e-12)
+    person.carry()
+    assert not person.walked_on  # carried standing: it comes back on its blob
+    person.come_back(np.array([0.9, 0.3, 1.0]))
+    np.testing.assert_allclose(person.pose[:2], np.array([0.9, 0.3]) + person.anchor)
+    person.part_visible[:] = True
+    for i in range(3):  # in full view again, 0.6 m/s along -y: the walk before is too old to count
+        person.settle(person.pose - np.eye(model.num_dofs)[1] * 0.02, np.array([0.0, -0.6]))
+    np.testing.assert_allclose(person.step(), [0.0, -0.02], atol=1e-12)
+    for i in range(3):  # speeding up to 0.9 m/s, the blob's velocity lagging at 0.6: the estimates'
+        person.settle(person.pose - np.eye(model.num_dofs)[1] * 0.03, np.array([0.0, -0.6]))
+    np.testing.assert_allclose(person.step(), [0.0, -0.026], atol=1e-12)  # (2 x 0.02 + 3 x 0.03) / 5
