@@ -2,9 +2,10 @@
 
 Used when the real mocap clips are absent and for motions they lack (sitting). A body is a
 :class:`BodyDims` (segment lengths) and a pose is a vector of ``POSE_SIZE`` numbers (root
-position and joint angles, layout in :data:`POSE_NAMES`); :func:`joints_from_pose` turns
-poses into the 15 canonical joints of :mod:`occupose.joints`, (T, 15, 3) float64, world
-metres, z up, floor z = 0.
+position and joint angles, layout in :data:`POSE_NAMES`); :func:`joints_from_procedural`
+turns poses into the 15 canonical joints of :mod:`occupose.joints`, (T, 15, 3) float64,
+world metres, z up, floor z = 0. (The tracker's body models have poses of their own,
+:mod:`occupose.body.model`; these are the generator's.)
 
 Actions map a start pose (D,) to the poses of the frames that follow it, (n, D), at a
 given frame rate; each begins where the previous one ended, so they chain without jumps:
@@ -76,7 +77,7 @@ def pose_with(pose, **values) -> np.ndarray:
     return out
 
 
-def standing_pose(xy=(0.0, 0.0), heading: float = 0.0, dims: BodyDims = DEFAULT_DIMS) -> np.ndarray:
+def stance(xy=(0.0, 0.0), heading: float = 0.0, dims: BodyDims = DEFAULT_DIMS) -> np.ndarray:
     """Relaxed upright pose (D,): pelvis above ``xy`` (metres), feet under the hips, arms down."""
     xy = np.asarray(xy, dtype=np.float64)
     if xy.shape != (2,) or not np.all(np.isfinite(xy)):
@@ -149,7 +150,7 @@ def _hips(poses, dims: BodyDims) -> np.ndarray:
     return poses[:, None, X:Z + 1] + np.array([half, -half])[None, :, None] * left[:, None, :]
 
 
-def joints_from_pose(poses, dims: BodyDims = DEFAULT_DIMS) -> np.ndarray:
+def joints_from_procedural(poses, dims: BodyDims = DEFAULT_DIMS) -> np.ndarray:
     """Canonical joints of poses.
 
     poses : (..., D) float, pose vectors (layout :data:`POSE_NAMES`).
@@ -217,7 +218,7 @@ def _set_legs(poses, ankles, dims: BodyDims) -> None:
 
 def _ankles(pose, dims: BodyDims) -> np.ndarray:
     """(2, 3) left and right ankles of one pose."""
-    j = joints_from_pose(pose, dims)
+    j = joints_from_procedural(pose, dims)
     return j[[JOINT_INDEX["left_ankle"], JOINT_INDEX["right_ankle"]]]
 
 
@@ -815,7 +816,7 @@ class MotionBuilder:
                  fps: float = 30.0, start_pose=None):
         self.dims = dims
         self.fps = _check_positive("fps", fps, "frames per second")
-        first = standing_pose(start_xy, heading, dims) if start_pose is None else _check_pose(start_pose, "start_pose")
+        first = stance(start_xy, heading, dims) if start_pose is None else _check_pose(start_pose, "start_pose")
         self._chunks = [first[None]]
         self._segments: list[Segment] = []
         self._num_frames = 1
@@ -873,7 +874,7 @@ class MotionBuilder:
 
     def joints(self) -> np.ndarray:
         """All frames as canonical joints, (T, 15, 3) float64, world metres."""
-        return joints_from_pose(self.poses(), self.dims)
+        return joints_from_procedural(self.poses(), self.dims)
 
     def segments(self) -> list[Segment]:
         """The frame range of each action so far, in order."""

@@ -40,9 +40,9 @@ def script():
 @pytest.fixture(scope="module")
 def straight():
     """Poses and joints of a 6 m walk along +x at 1.3 m/s, start frame included."""
-    start = m.standing_pose((0.0, 0.0), 0.0)
+    start = m.stance((0.0, 0.0), 0.0)
     poses = np.vstack([start, m.walk(start, [(6.0, 0.0)], 1.3, fps=FPS)])
-    return poses, m.joints_from_pose(poses)
+    return poses, m.joints_from_procedural(poses)
 
 
 # ---------------------------------------------------------------------------------------
@@ -52,7 +52,7 @@ def straight():
 def test_default_body_is_an_average_adult():
     dims = BodyDims()
     assert dims.height == pytest.approx(1.72)
-    j = m.joints_from_pose(m.standing_pose())
+    j = m.joints_from_procedural(m.stance())
     assert dims.hip_height == pytest.approx(0.92)
     assert j[J["left_hip"], 2] == pytest.approx(dims.hip_height, abs=1e-3)  # the knees barely bent
     assert j.shape == (15, 3) and j.dtype == np.float64
@@ -75,20 +75,20 @@ def test_scaled_body_keeps_proportions():
 
 
 def test_left_is_left_of_the_facing_direction():
-    j = m.joints_from_pose(m.standing_pose((1.0, 2.0), heading=math.pi / 2))  # facing +y
+    j = m.joints_from_procedural(m.stance((1.0, 2.0), heading=math.pi / 2))  # facing +y
     assert j[J["left_hip"], 0] < j[J["right_hip"], 0]
     assert j[J["left_shoulder"], 0] < j[J["right_shoulder"], 0]
     assert j[J["left_ankle"], 0] < j[J["right_ankle"], 0]
     for heading in (0.0, 0.7, -2.5, 3.0):
-        assert angle_diff(facing(m.joints_from_pose(m.standing_pose(heading=heading))), heading) < 1e-9
+        assert angle_diff(facing(m.joints_from_procedural(m.stance(heading=heading))), heading) < 1e-9
 
 
 def test_pose_angle_conventions():
-    base = m.standing_pose()
-    j0 = m.joints_from_pose(base)
+    base = m.stance()
+    j0 = m.joints_from_procedural(base)
 
     def moved(**values):
-        return m.joints_from_pose(m.pose_with(base, **values))
+        return m.joints_from_procedural(m.pose_with(base, **values))
 
     # facing +x: forward is +x, left is +y, up is +z
     assert moved(right_shoulder_flex=math.pi / 2)[J["right_wrist"], 0] > 0.5   # arm forward
@@ -110,26 +110,26 @@ def test_pose_angle_conventions():
     np.testing.assert_allclose(mirror[J["left_wrist"]] * [1, -1, 1], mirror[J["right_wrist"]], atol=1e-12)
 
 
-def test_joints_from_pose_batches_and_checks_shape():
-    poses = np.stack([m.standing_pose(heading=h) for h in (0.0, 1.0, 2.0)])
-    batch = m.joints_from_pose(poses.reshape(3, 1, -1))
+def test_joints_from_procedural_batches_and_checks_shape():
+    poses = np.stack([m.stance(heading=h) for h in (0.0, 1.0, 2.0)])
+    batch = m.joints_from_procedural(poses.reshape(3, 1, -1))
     assert batch.shape == (3, 1, 15, 3)
-    np.testing.assert_allclose(batch[1, 0], m.joints_from_pose(poses[1]), atol=1e-12)
+    np.testing.assert_allclose(batch[1, 0], m.joints_from_procedural(poses[1]), atol=1e-12)
     with pytest.raises(ValueError, match=r"\(\.\.\., 22\)"):
-        m.joints_from_pose(np.zeros((4, 21)))
+        m.joints_from_procedural(np.zeros((4, 21)))
     with pytest.raises(ValueError, match="unknown pose entry 'knee'"):
-        m.pose_with(m.standing_pose(), knee=0.3)
+        m.pose_with(m.stance(), knee=0.3)
 
 
 def test_leg_inverse_kinematics_round_trip(rng):
     dims = BodyDims()
     n = 200
-    poses = np.repeat(m.standing_pose()[None], n, axis=0)
+    poses = np.repeat(m.stance()[None], n, axis=0)
     poses[:, m.HEADING] = rng.uniform(-np.pi, np.pi, n)
     poses[:, m.LEFT + m.HIP_FLEX] = rng.uniform(-0.5, 1.6, n)
     poses[:, m.LEFT + m.HIP_ABD] = rng.uniform(-0.3, 0.5, n)
     poses[:, m.LEFT + m.KNEE] = rng.uniform(0.05, 2.0, n)
-    j = m.joints_from_pose(poses, dims)
+    j = m.joints_from_procedural(poses, dims)
     angles = m._leg_angles(j[:, J["left_hip"]], j[:, J["left_ankle"]], poses[:, m.HEADING], 1.0, dims)
     np.testing.assert_allclose(angles, poses[:, m.LEFT + m.HIP_FLEX:m.LEFT + m.KNEE + 1], atol=1e-9)
 
@@ -188,7 +188,7 @@ def test_walk_moves_along_the_path_at_the_requested_speed(straight):
     duration = (len(poses) - 1) / FPS
     assert 6.0 / 1.3 < duration < 6.0 / 1.3 + 1.2      # plus speeding up, braking, closing the feet
     for speed_request in (0.9, 1.6):
-        p = m.walk(m.standing_pose(), [(6.0, 0.0)], speed_request)
+        p = m.walk(m.stance(), [(6.0, 0.0)], speed_request)
         v = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1) * FPS
         assert np.mean(v[45:-45]) == pytest.approx(speed_request, rel=0.05)
 
@@ -235,9 +235,9 @@ def test_walking_feet_stay_on_the_floor_and_do_not_slide(straight):
 
 
 def test_heading_follows_the_path():
-    start = m.standing_pose((0.0, 0.0), 0.0)
+    start = m.stance((0.0, 0.0), 0.0)
     poses = m.walk(start, [(3.0, 0.0), (3.0, 3.0)], 1.2)
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     pelvis = j[:, J["pelvis"], :2]
     assert angle_diff(facing(j[-1]), np.pi / 2) < 1e-6
     velocity = np.gradient(pelvis, axis=0)
@@ -248,7 +248,7 @@ def test_heading_follows_the_path():
     assert np.abs(np.diff(poses[:, m.HEADING])).max() * FPS < 3.5
     # a walk starting the wrong way turns on the spot first, towards the path
     back = m.walk(start, [(-3.0, 0.0)], 1.2)
-    jb = m.joints_from_pose(back)
+    jb = m.joints_from_procedural(back)
     turning = np.flatnonzero(np.linalg.norm(jb[:, J["pelvis"], :2], axis=1) < 1e-9)
     assert len(turning) > 15
     assert angle_diff(facing(jb[turning[-1]]), np.pi) < 1e-6
@@ -256,7 +256,7 @@ def test_heading_follows_the_path():
 
 
 def test_walk_rejects_bad_paths_and_speeds():
-    start = m.standing_pose()
+    start = m.stance()
     with pytest.raises(ValueError, match=r"path_xy must be finite waypoints of shape \(K, 2\)"):
         m.walk(start, [1.0, 2.0])
     with pytest.raises(ValueError, match="lead away from the start"):
@@ -271,9 +271,9 @@ def test_walk_rejects_bad_paths_and_speeds():
 
 
 def test_turn_steps_round_without_sliding():
-    start = m.standing_pose((1.0, 1.0), 0.5)
+    start = m.stance((1.0, 1.0), 0.5)
     poses = np.vstack([start, m.turn(start, 0.5 - 2.8, fps=FPS)])
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     assert angle_diff(facing(j[-1]), 0.5 - 2.8) < 1e-9
     np.testing.assert_allclose(j[:, J["pelvis"], :2], 1.0, atol=1e-12)
     for side in ("left", "right"):
@@ -291,7 +291,7 @@ def test_turn_steps_round_without_sliding():
 
 def test_sitting_down_puts_the_pelvis_on_the_seat():
     dims = BodyDims()
-    start = m.standing_pose((0.0, 0.0), heading=math.pi)   # facing -x: the seat is towards +x
+    start = m.stance((0.0, 0.0), heading=math.pi)   # facing -x: the seat is towards +x
     b = m.MotionBuilder(start_pose=start).sit_down(0.45, 1.8).sitting(2.0)
     j = b.joints()
     seated = j[b.segments()[1].start:b.segments()[1].stop]
@@ -312,7 +312,7 @@ def test_sitting_down_puts_the_pelvis_on_the_seat():
 
 
 def test_standing_up_returns_to_the_standing_pose():
-    start = m.standing_pose((2.0, -1.0), heading=0.3)
+    start = m.stance((2.0, -1.0), heading=0.3)
     b = m.MotionBuilder(start_pose=start).sit_down(0.5).stand_up(1.8)
     np.testing.assert_allclose(b.pose, start, atol=1e-9)
     lean = b.poses()[b.segments()[1].start:, m.TRUNK_LEAN]
@@ -321,24 +321,24 @@ def test_standing_up_returns_to_the_standing_pose():
 
 def test_seat_height_and_start_pose_are_checked():
     with pytest.raises(ValueError, match=r"seat_height must be in \["):
-        m.sit_down(m.standing_pose(), seat_height=0.9)
+        m.sit_down(m.stance(), seat_height=0.9)
     with pytest.raises(ValueError, match="call sit_down first"):
-        m.stand_up(m.standing_pose())
+        m.stand_up(m.stance())
     with pytest.raises(ValueError, match="call sit_down first"):
-        m.sitting(m.standing_pose(), 1.0)
+        m.sitting(m.stance(), 1.0)
     with pytest.raises(ValueError, match="call stand_up first"):
-        m.sit_down(m.sit_down(m.standing_pose())[-1])
+        m.sit_down(m.sit_down(m.stance())[-1])
 
 
 def test_idle_standing_sways_a_little_and_ends_where_it_started():
-    start = m.standing_pose()
+    start = m.stance()
     poses = m.stand(start, 4.0)
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     shift = np.linalg.norm(j[:, J["pelvis"], :2], axis=1)
     assert 0.003 < shift.max() < 0.03
     np.testing.assert_allclose(poses[-1], start, atol=1e-9)
     ankles = j[:, [J["left_ankle"], J["right_ankle"]]]
-    np.testing.assert_allclose(ankles, np.broadcast_to(m.joints_from_pose(start)[[J["left_ankle"], J["right_ankle"]]],
+    np.testing.assert_allclose(ankles, np.broadcast_to(m.joints_from_procedural(start)[[J["left_ankle"], J["right_ankle"]]],
                                                        ankles.shape), atol=1e-6)
 
 
@@ -348,9 +348,9 @@ def test_idle_standing_sways_a_little_and_ends_where_it_started():
 
 @pytest.mark.parametrize("arm", ["left", "right", "both"])
 def test_wave_raises_the_wrist_above_the_shoulder(arm):
-    start = m.standing_pose()
+    start = m.stance()
     poses = m.wave(start, arm, duration=2.5, cycles=3)
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     middle = slice(20, -20)
     sides = ("left", "right") if arm == "both" else (arm,)
     for side in ("left", "right"):
@@ -368,13 +368,13 @@ def test_wave_raises_the_wrist_above_the_shoulder(arm):
 
 
 def test_gestures():
-    start = m.standing_pose()
-    j0 = m.joints_from_pose(start)
+    start = m.stance()
+    j0 = m.joints_from_procedural(start)
 
     def held(name, arm="right"):
         poses = m.gesture(start, name, arm, duration=2.0)
         np.testing.assert_allclose(poses[-1], start, atol=1e-12)
-        return m.joints_from_pose(poses[len(poses) // 2])
+        return m.joints_from_procedural(poses[len(poses) // 2])
 
     assert held("raise")[J["right_wrist"], 2] > j0[J["head"], 2] + 0.2
     point = held("point", "left")
@@ -394,7 +394,7 @@ def test_gestures():
 
 
 def test_keyframes_interpolate_smoothly_through_the_keys():
-    start = m.standing_pose()
+    start = m.stance()
     key1 = m.pose_with(start, right_shoulder_flex=1.2, x=0.2)
     key2 = m.pose_with(start, right_shoulder_flex=0.4, x=0.3)
     for interpolation in m.INTERPOLATIONS:
@@ -444,8 +444,8 @@ def test_motion_is_deterministic(script):
 
 def test_frame_rate_sets_the_frame_count():
     for fps in (15.0, 30.0, 60.0):
-        assert m.stand(m.standing_pose(), 2.0, fps=fps).shape == (int(2 * fps), m.POSE_SIZE)
+        assert m.stand(m.stance(), 2.0, fps=fps).shape == (int(2 * fps), m.POSE_SIZE)
     with pytest.raises(ValueError, match="fps must be a positive number"):
         m.MotionBuilder(fps=0)
     with pytest.raises(ValueError, match="duration must be a positive number"):
-        m.stand(m.standing_pose(), -1.0)
+        m.stand(m.stance(), -1.0)
