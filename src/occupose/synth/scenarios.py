@@ -26,9 +26,10 @@ import numpy as np
 from occupose.body.dims import BodyDims, DEFAULT_DIMS, dims_from_joints
 from occupose.camera import Camera, camera_preset, look_at, sensor_spec
 from occupose.joints import JOINT_INDEX as J
-from occupose.io.mocap import canonical_from_clip, facing_from_joints as facing, find_clip, load_clip, place, resample
+from occupose.io.mocap import canonical_from_clip, find_clip, load_clip
 from occupose.synth import motion as pm
 from occupose.synth.body import BodyShape, random_body_shape
+from occupose.synth.retarget import facing_from_joints as facing, place, resample
 from occupose.geometry.primitives import Primitives, concat
 from occupose.synth.scene import chair, cabinet, couch, room, table
 from occupose.synth.sequence import chain

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from occupose.body.dims import BodyDims
-from occupose.io.mocap import facing_from_joints as facing
+from occupose.synth.retarget import facing_from_joints as facing
 from occupose.joints import JOINT_INDEX as J
 from occupose.synth import motion as m
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from occupose.body.dims import BodyDims, bone_lengths_from_dims, dims_from_joints
-from occupose.io.mocap import bone_lengths, facing_from_joints as facing
+from occupose.io.mocap import bone_lengths
+from occupose.synth.retarget import facing_from_joints as facing
 from occupose.joints import BONES, JOINT_INDEX as J
 from occupose.synth import motion as m
 from occupose.synth.motion.pose import _leg_angles
