@@ -417,7 +417,7 @@ def _walker_profiles(dims: BodyDims):
     """Breadth profiles of a procedural person of ``dims`` walking towards the camera of
     no_occlusion (seen from the front), every third of 30 frames, with each frame's true
     neck depth below the top of its points."""
-    from occupose.synth.generate import person_observations
+    from occupose.testing import person_observations
 
     scenario = build_scenario("no_occlusion", use_mocap=False)
     joints = sm.MotionBuilder((0.3, 3.6), -math.pi / 2, dims, scenario.fps).walk([(0.3, 2.6)]).joints()

@@ -11,7 +11,7 @@ from occupose.likelihood import Observation
 from occupose.pose.problem import PoseEstimator, PoseProblem
 from occupose.pose.proposals import (FOOT_LOST, feet, forward, limb_dofs, limb_proposals, mirrored_legs,
                                  reach_towards, unexplained_points)
-from occupose.synth.generate import person_observations
+from occupose.testing import person_observations
 from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 
