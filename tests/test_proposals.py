@@ -188,10 +188,10 @@ def test_a_lost_leg_is_proposed_where_its_foot_is_only_for_a_standing_person(ste
 
 def test_reach_towards_bends_a_knee_forwards_where_nothing_is_seen():
     hip, ankle = np.array([0.0, 0.0, 0.9]), np.array([0.0, 0.0, 0.2])  # 0.7 m below: a bent leg of 0.45 + 0.43
-    for forward in ([1.0, 0.0, 0.0], [0.0, -1.0, 0.0]):
-        knee, end = reach_towards(hip, ankle, 0.45, 0.43, None, bend=np.array(forward))
+    for ahead in ([1.0, 0.0, 0.0], [0.0, -1.0, 0.0]):
+        knee, end = reach_towards(hip, ankle, 0.45, 0.43, None, bend=np.array(ahead))
         assert np.array_equal(end, ankle)
-        assert (knee - hip) @ forward > 0.2  # of the 8 places on the circle, the most forwards
+        assert (knee - hip) @ ahead > 0.2  # of the 8 places on the circle, the most forwards
         assert abs(np.linalg.norm(knee - hip) - 0.45) < 1e-9
 
 
