@@ -37,9 +37,9 @@ from occupose.camera import points_from_depth
 from scipy import ndimage
 
 from occupose.grid.blobs import blobs_from_mask
-from occupose.grid.hold import MARGIN, capsules_from_primitives, cells_near_capsules
+from occupose.grid.hold import MARGIN, cells_near_capsules
 from occupose.grid.pixels import (
-    distance_to_points, pixels_from_depth, persons_from_tracks, predicted_from_tracks,
+    distance_to_points, pixels_from_depth, predicted_from_tracks,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
@@ -50,6 +50,7 @@ from occupose.synth.generate import frames
 from occupose.geometry.primitives import concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
+from occupose.testing import capsules_from_primitives, persons_from_tracks
 
 TITLE = "Blobs: labelling + blob tracking on 80x80x50 cells, and per-person observations (ms per frame)"
 ACCURACY_TITLE = "Blobs: pixel assignment between two people (exclusion principle)"

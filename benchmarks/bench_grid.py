@@ -31,8 +31,8 @@ import numpy as np
 
 from benchmarks import median_ms
 from occupose.grid.baseline import DepthBackgroundSubtractor
-from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
-from occupose.grid.occupancy import OccupancyGrid, cells_from_depth, foreground_from_grid, spec_from_cameras
+from occupose.grid.hold import cells_near_capsules
+from occupose.grid.occupancy import OccupancyGrid, cells_from_depth, spec_from_cameras
 from occupose.grid.spec import GridSpec
 from occupose.evaluation.metrics import foreground_scores
 from occupose.synth.body import primitives_from_joints
@@ -40,6 +40,7 @@ from occupose.synth.generate import frames
 from occupose.geometry.primitives import concat
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
+from occupose.testing import capsules_from_primitives, foreground_from_grid
 
 TITLE = "Occupancy grid: one update and back-projection (ms per frame)"
 ACCURACY_TITLE = "Occupancy grid (HMM) vs per-pixel MOG2 on depth: foreground per scenario"

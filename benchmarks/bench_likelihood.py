@@ -66,7 +66,7 @@ def run(repeats: int = 11) -> list[dict]:
     model, particles, evaluations per particle (what), threads, ms_median, ms_min,
     M_evals_per_s (median, wall clock), cpu_ms_1thread, M_evals_per_s_per_core, load."""
     rng = np.random.default_rng(0)
-    joints = pm.joints_from_pose(pm.pose_with(pm.standing_pose(), right_shoulder_flex=0.6, right_elbow=0.8,
+    joints = pm.joints_from_procedural(pm.pose_with(pm.stance(), right_shoulder_flex=0.6, right_elbow=0.8,
                                               left_shoulder_abd=0.5))
     front = _observation(joints, (3.0, 0.0, 1.4), (0.0, 0.0, 0.9), ("-x",))
     top = _observation(joints, (0.0, 0.0, 3.2), (0.0, 0.0, 0.0), ())

@@ -17,10 +17,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from occupose.grid.pixels import persons_from_tracks
 from occupose.evaluation.metrics import pixel_assignment_accuracy
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
+from occupose.testing import persons_from_tracks
 from occupose.tracker import Tracker, track_frames
 
 TITLE = "Tracker speed: frames/s of `occupose track` (ours), start-up excluded, and ms per frame per stage"

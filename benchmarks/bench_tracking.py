@@ -37,9 +37,9 @@ from occupose.evaluation.metrics import ARM_PARTS, arm_epsilons, frame_errors, i
 from occupose.paths import mocap_dir
 from occupose.pose.estimator import PoseEstimator
 from occupose.pose.problem import PoseProblem
-from occupose.synth.generate import UPPER_BODY_PARTS, person_observations
 from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
+from occupose.testing import UPPER_BODY_PARTS, person_observations
 
 TITLE = "Single-person tracking: error versus time per frame (the second paper's Fig. 5; cm, ms)"
 PLOT = Path(__file__).parent / "results" / "fig5_error_vs_time.png"

@@ -218,7 +218,7 @@ def test_trunk_lean_and_knee():
 def test_full_model_reproduces_the_generator_arms_and_legs():
     """Same angles as occupose.synth.motion give the same joints (trunk lean only)."""
     m = BODY_MODELS["full"]
-    gen = sm.pose_with(sm.standing_pose(heading=0.7), trunk_lean=0.3, left_shoulder_flex=1.0,
+    gen = sm.pose_with(sm.stance(heading=0.7), trunk_lean=0.3, left_shoulder_flex=1.0,
                        left_shoulder_abd=0.4, left_shoulder_rot=0.5, left_elbow=1.2, right_hip_flex=0.8,
                        right_hip_abd=0.2, right_knee=1.0, neck_flex=0.3)
     pose = _pose(m, x=gen[0], y=gen[1], z=gen[2], heading=0.7, trunk_lean=0.3, neck_flex=0.3)
@@ -226,7 +226,7 @@ def test_full_model_reproduces_the_generator_arms_and_legs():
         for name in ("shoulder_flex", "shoulder_abd", "shoulder_rot", "elbow", "hip_abd", "knee"):
             pose[m.dof(f"{side}_{name}")] = gen[sm.POSE_INDEX[f"{side}_{name}"]]
         pose[m.dof(f"{side}_hip_flex")] = gen[sm.POSE_INDEX[f"{side}_hip_flex"]] + 0.3
-    np.testing.assert_allclose(joints_from_poses(m, pose[None])[0], sm.joints_from_pose(gen), atol=1e-12)
+    np.testing.assert_allclose(joints_from_poses(m, pose[None])[0], sm.joints_from_procedural(gen), atol=1e-12)
 
 
 def test_poses_are_checked():
@@ -417,7 +417,7 @@ def _walker_profiles(dims: BodyDims):
     """Breadth profiles of a procedural person of ``dims`` walking towards the camera of
     no_occlusion (seen from the front), every third of 30 frames, with each frame's true
     neck depth below the top of its points."""
-    from occupose.synth.generate import person_observations
+    from occupose.testing import person_observations
 
     scenario = build_scenario("no_occlusion", use_mocap=False)
     joints = sm.MotionBuilder((0.3, 3.6), -math.pi / 2, dims, scenario.fps).walk([(0.3, 2.6)]).joints()

@@ -12,14 +12,15 @@ import pytest
 from occupose.camera import Camera, camera_preset, look_at, pixels_from_points, points_from_depth, sensor_spec
 from occupose.grid.baseline import DepthBackgroundSubtractor
 from occupose.grid.occupancy import (
-    FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth, foreground_from_grid,
+    FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth,
     frames_until_static, observation_function, spec_from_cameras, transition_matrix,
 )
-from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
+from occupose.grid.hold import cells_near_capsules
 from occupose.grid.spec import GridSpec
 from occupose.joints import JOINT_INDEX
 from occupose.evaluation.metrics import foreground_scores
 from occupose.synth.generate import frames
+from occupose.testing import capsules_from_primitives, foreground_from_grid
 from occupose.synth.body import primitives_from_joints, random_body_shape
 from occupose.sensors import depth_std
 from occupose.synth.noise import apply_noise

@@ -89,7 +89,7 @@ ARMS_OUT = dict(right_shoulder_flex=0.6, right_elbow=0.8, left_shoulder_abd=0.5)
 @pytest.fixture(scope="module")
 def front():
     """A person facing a Kinect 2.5 m away in an empty room: observation, the fitted true pose."""
-    joints = pm.joints_from_pose(pm.pose_with(pm.standing_pose(), **ARMS_OUT))
+    joints = pm.joints_from_procedural(pm.pose_with(pm.stance(), **ARMS_OUT))
     return _frame(joints, static=_room()), pose_from_joints(FULL, joints)
 
 
@@ -461,7 +461,7 @@ def test_true_pose_scores_best_over_body_shapes():
     five (on the sixth a thigh 0.25 rad forward, nearer the camera, fits the front of the
     thicker rendered thigh better: the points term sees only the near surface, and the
     free-space term is what vetoes the model leg in front of it)."""
-    joints = pm.joints_from_pose(pm.pose_with(pm.standing_pose(), **ARMS_OUT))
+    joints = pm.joints_from_procedural(pm.pose_with(pm.stance(), **ARMS_OUT))
     pose = pose_from_joints(FULL, joints)
     capsules = _model_capsules(FULL, _perturbed(FULL, pose, FULL_DOFS))
     wins = {"points": 0, "points+free": 0, "render": 0}
@@ -494,7 +494,7 @@ def test_full_torso_shows_the_heading(front):
 
 def test_color_true_pose_scores_best():
     """Reference histograms from the estimate of the frame before; flashy clothes (one colour per part)."""
-    joints = pm.joints_from_pose(np.array([pm.pose_with(pm.standing_pose(), right_shoulder_flex=f, left_elbow=e)
+    joints = pm.joints_from_procedural(np.array([pm.pose_with(pm.stance(), right_shoulder_flex=f, left_elbow=e)
                                            for f, e in ((0.5, 0.6), (0.6, 0.8))]))
     room = _room()
     before = _frame(joints[0], room, clothing="flashy", seed=2)
@@ -511,7 +511,7 @@ def test_color_true_pose_scores_best():
 def test_points_true_pose_scores_best_from_above():
     """The upper-body model under a ceiling camera (the second paper's setting)."""
     camera = camera_preset("kinect_v1", world_from_camera=look_at((0.0, 0.0, 3.2), (0.0, 0.0, 0.0)))
-    joints = pm.joints_from_pose(pm.pose_with(pm.standing_pose(), right_shoulder_flex=1.2, left_shoulder_abd=0.6))
+    joints = pm.joints_from_procedural(pm.pose_with(pm.stance(), right_shoulder_flex=1.2, left_shoulder_abd=0.6))
     obs = _frame(joints, scene.room(walls=()), camera=camera)
     pose = pose_from_joints(UPPER, joints)
     dofs = ("x", "y", "heading", "trunk_lean", "left_shoulder_flex", "left_shoulder_abd", "right_shoulder_flex",
@@ -539,7 +539,7 @@ def test_free_space_penalises_an_arm_in_seen_empty_space(front):
 def test_free_space_does_not_penalise_legs_behind_a_desk():
     """Legs hidden by a desk's front panel (all but the tops of the thighs): the desk is in
     front of the leg samples, at the true pose and with the legs spread behind it."""
-    joints = pm.joints_from_pose(pm.standing_pose(xy=(-0.1, 0.0)))
+    joints = pm.joints_from_procedural(pm.stance(xy=(-0.1, 0.0)))
     room = _room()
     desk = scene.table((0.45, 0.0), size=(1.2, 0.5), panel=True)
     obs = _frame(joints, concat([room, desk]))

@@ -6,10 +6,10 @@ import pytest
 
 from occupose.camera import Camera, look_at, points_from_depth
 from occupose.grid.blobs import blobs_from_mask
-from occupose.grid.hold import capsules_from_primitives, cells_near_capsules
+from occupose.grid.hold import cells_near_capsules
 from occupose.grid.pixels import (
     FALLBACKS, PersonPixels, _nearest_track, distance_to_points, pixels_from_depth,
-    persons_from_tracks, predicted_from_tracks,
+    predicted_from_tracks,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
@@ -18,6 +18,7 @@ from occupose.evaluation.metrics import foreground_scores, pixel_assignment_accu
 from occupose.synth.body import primitives_from_joints
 from occupose.synth.noise import apply_noise
 from occupose.geometry.primitives import box, concat
+from occupose.testing import capsules_from_primitives, persons_from_tracks
 from occupose.synth.render import render_camera
 from occupose.synth.scenarios import build_scenario
 

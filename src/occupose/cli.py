@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import click
@@ -17,22 +16,6 @@ def _progress_bar(total: int, desc: str):
     from tqdm import tqdm
 
     return tqdm(total=total, desc=desc, unit="frame", dynamic_ncols=True, mininterval=1.0)
-
-
-def _clear_output(out: Path, force: bool) -> None:
-    """Make ``out`` ready for a new recording: it must not exist, be empty, or (with
-    ``force``) be an earlier recording, which is removed. Anything else is refused."""
-    if not out.exists():
-        return
-    if not out.is_dir():
-        _fail(f"{out} exists and is not a folder")
-    if not any(out.iterdir()):
-        return
-    if not force:
-        _fail(f"{out} exists and is not empty (use --force to replace an earlier recording)")
-    if not (out / "recording.json").is_file():
-        _fail(f"{out} is not a recording folder (no recording.json): not removing it, even with --force")
-    shutil.rmtree(out)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -54,22 +37,39 @@ def scenarios_cmd() -> None:
         click.echo(f"{name:<{width}}  {entry.summary}")
 
 
+#: The CLI's words for what stands in the way of ``occupose synth``'s output (OutputInTheWay.reason).
+_IN_THE_WAY = {
+    "not a folder": "{out} exists and is not a folder",
+    "not empty": "{out} exists and is not empty (use --force to replace an earlier recording)",
+    "not a recording": "{out} is not a recording folder (no recording.json): not removing it, even with --force",
+}
+
+
 def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: str | None,
                  force: bool, procedural: bool = False) -> Path:
-    from occupose.synth.generate import write_scenario
-    from occupose.synth.scenarios import build_scenario
+    from occupose.synth.catalogue import FramesOutOfRange, OutputInTheWay, render_scenario
+
+    bars = []  # opened when the catalogue knows the number of frames, before the first is rendered
+
+    def progress(done: int, total: int) -> None:
+        if not bars:
+            bars.append(_progress_bar(total, f"rendering {name}"))
+        bars[0].update(done)
 
     try:
-        scenario = build_scenario(name, seed=seed, sensor=sensor, use_mocap=not procedural)
+        made = render_scenario(name, out, seed=seed, frames=frames, sensor=sensor, procedural=procedural,
+                               exists="replace" if force else "refuse", progress=progress)
+    except FramesOutOfRange as error:
+        _fail(f"--frames must be in 1..{error.available} for {name}, got {frames}")
+    except OutputInTheWay as error:
+        _fail(_IN_THE_WAY[error.reason].format(out=out))
     except ValueError as error:
         _fail(str(error))
-    total = scenario.num_frames if frames is None else frames
-    if not 0 < total <= scenario.num_frames:
-        _fail(f"--frames must be in 1..{scenario.num_frames} for {name}, got {frames}")
-    _clear_output(out, force)
-    with _progress_bar(total, f"rendering {name}") as bar:
-        write_scenario(scenario, out, seed=seed, num_frames=total, progress=bar.update)
-    click.echo(f"wrote {out} ({total} frames, {len(scenario.cameras)} camera(s), "
+    finally:
+        for bar in bars:
+            bar.close()
+    scenario = made.scenario
+    click.echo(f"wrote {out} ({made.num_frames} frames, {len(scenario.cameras)} camera(s), "
                f"{len(scenario.people)} person(s); motion: {scenario.motion_source})")
     return out
 

@@ -41,7 +41,8 @@ from occupose.pose.problem import (
     default_stages,
     unseen_arms,
 )
-from occupose.synth.generate import UPPER_BODY_PARTS, frames, person_observations
+from occupose.synth.generate import frames
+from occupose.testing import UPPER_BODY_PARTS, person_observations
 from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 

@@ -13,7 +13,7 @@ from occupose.pose.estimator import PoseEstimator
 from occupose.pose.problem import PoseProblem
 from occupose.pose.proposals import (feet, forward, limb_dofs, limb_proposals, mirrored_legs,
                                  reach_towards, unexplained_points)
-from occupose.synth.generate import person_observations
+from occupose.testing import person_observations
 from occupose.body.dims import dims_from_joints
 from occupose.synth.scenarios import build_scenario
 

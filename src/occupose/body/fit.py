@@ -205,5 +205,5 @@ def standing_pose(model: BodyModel, xy=(0.0, 0.0), heading: float = 0.0) -> np.n
     """A relaxed upright pose (D,) of ``model``: pelvis above ``xy`` (metres), facing
     ``heading`` (radians about +z, 0 = +x), arms hanging (the procedural generator's stance
     for the model's dims, fitted)."""
-    joints = sm.joints_from_pose(sm.standing_pose(xy, heading, model.dims), model.dims)
+    joints = sm.joints_from_procedural(sm.stance(xy, heading, model.dims), model.dims)
     return pose_from_joints(model, joints)

@@ -29,13 +29,11 @@ left out of those, and FAILs), and its status is FAIL when *any* run FAILs.
 from __future__ import annotations
 
 import csv
-import hashlib
 import json
 import math
 import multiprocessing
 import os
 import queue as queue_module
-import shutil
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field, fields
@@ -140,34 +138,19 @@ def render_recording(scenario: str, out: Path, frames: int | None, procedural: b
                      progress: Callable[[int], None] | None = None) -> Path:
     """Render ``scenario`` (scene seed SCENE_SEED) into the recording folder ``out``, or
     keep the one already there when it was rendered with the same settings and the same
-    ground-truth motion.
+    ground-truth motion (occupose.synth.catalogue, policy "reuse").
 
     frames : at most this many frames (None: all); procedural : never use mocap clips.
     An existing folder rendered differently (or half-written) is replaced.
     """
-    from occupose.synth.generate import write_scenario
-    from occupose.synth.scenarios import build_scenario
+    from occupose.synth.catalogue import render_scenario
 
-    built = build_scenario(scenario, seed=SCENE_SEED, use_mocap=not procedural)
-    total = built.num_frames if frames is None else min(frames, built.num_frames)
-    # the ground truth's digest: a recording of motion the scenario no longer makes is stale
-    truth = hashlib.sha1(b"".join(np.ascontiguousarray(p.joints[:total]).tobytes() for p in built.people))
-    info = {"scenario": scenario, "seed": SCENE_SEED, "frames": total, "motion_source": built.motion_source,
-            "events": {k: list(v) for k, v in built.events.items()}, "truth": truth.hexdigest()}
-    marker = out / RENDER_INFO
-    if marker.is_file() and (out / "recording.json").is_file():
-        try:
-            if json.loads(marker.read_text()) == info:
-                if progress is not None:
-                    progress(total)
-                return out
-        except ValueError:
-            pass  # unreadable: render again
-    if out.exists():
-        shutil.rmtree(out)
-    write_scenario(built, out, seed=SCENE_SEED, num_frames=total, progress=progress)
-    marker.write_text(json.dumps(info) + "\n")  # last: a folder without it is half-written
-    return out
+    def report(done: int, total: int) -> None:
+        if done:
+            progress(done)
+
+    return render_scenario(scenario, out, seed=SCENE_SEED, frames=frames, procedural=procedural, exists="reuse",
+                           clip_frames=True, progress=None if progress is None else report).path
 
 
 def arm_points(rec, person_ids: Sequence[int], max_points: int = ARM_SAMPLE) -> list[list[np.ndarray]]:

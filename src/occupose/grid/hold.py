@@ -5,9 +5,9 @@ With the paper's ``psi`` a cell that stays occupied in state M turns static (O) 
 stands or sits still fades into the background. The tracker knows better for the people
 it follows: it passes a hold mask to :meth:`occupose.grid.occupancy.OccupancyGrid.update`,
 which disables the M -> O transition in those cells for that frame. This module makes that
-mask from the round cones of the predicted bodies (``occupose.body.capsules_from_poses``),
-and, for tests and benchmarks that hold the true bodies, gives the capsules covering a
-rendered body (:func:`capsules_from_primitives`). For a body model's predicted pose::
+mask from the round cones of the predicted bodies (``occupose.body.capsules_from_poses``;
+tests and benchmarks that hold the true bodies take the capsules covering a rendered body
+from ``occupose.testing.capsules_from_primitives``). For a body model's predicted pose::
 
     a, b = capsules_from_poses(model, pose[None])            # (1, C, 3) each
     hold = cells_near_capsules(grid.spec, a[0], b[0], model.capsule_radii)
@@ -28,7 +28,6 @@ import numpy as np
 from occupose.config import GridConfig
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
-from occupose.geometry.primitives import BOX, ROUND_CONE, Primitives
 
 #: Default margin (metres) around each capsule: the half diagonal of a 5 cm cell (a cell
 #: whose centre is that far from the surface can still hold surface points) plus about
@@ -65,28 +64,3 @@ def cells_near_capsules(spec: GridSpec, a, b, radii, margin: float = MARGIN) -> 
     out = np.zeros(spec.shape, np.bool_)
     _kernels.mark_capsules(np.asarray(spec.origin), spec.cell, *spec.shape, a, b, radii, float(margin), out)
     return out
-
-
-def capsules_from_primitives(prims: Primitives) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Capsules covering a batch of renderer primitives (e.g. a true body,
-    :func:`occupose.synth.body.primitives_from_joints`).
-
-    Round cones are taken as they are; a box or an ellipsoid becomes the capsule along its
-    longest axis, from ``center - s axis`` to ``center + s axis`` (``s`` the longest half
-    extent), with the radius of its cross-section (the other two half extents' norm for a
-    box, their maximum for an ellipsoid), which contains it.
-    Returns a, b : (K, 3) float64 world metres and radii : (K, 2) float64 metres.
-    """
-    if not isinstance(prims, Primitives):
-        raise ValueError(f"prims must be occupose.geometry.primitives.Primitives, got {type(prims).__name__}")
-    cone = prims.kind == ROUND_CONE
-    longest = np.argmax(prims.size, axis=1)
-    rows = np.arange(len(prims))
-    axis = prims.axes[rows, :, longest]  # (K, 3): the column of the longest local axis
-    half = prims.size[rows, longest]
-    others = np.sort(prims.size, axis=1)[:, :2]  # the two shorter half extents
-    radius = np.where(prims.kind == BOX, np.hypot(others[:, 0], others[:, 1]), others[:, 1])
-    a = np.where(cone[:, None], prims.center, prims.center - half[:, None] * axis)
-    b = np.where(cone[:, None], prims.end, prims.center + half[:, None] * axis)
-    radii = np.where(cone[:, None], prims.size[:, :2], radius[:, None])
-    return np.ascontiguousarray(a), np.ascontiguousarray(b), np.ascontiguousarray(radii)

@@ -387,25 +387,6 @@ def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: 
     return out.reshape(camera.height, camera.width)
 
 
-def foreground_from_grid(states: np.ndarray, spec: GridSpec, depth: np.ndarray, camera: Camera) -> np.ndarray:
-    """Pixels whose back-projected 3D point lies in a moving cell (the paper's Fig. 2(d)).
-
-    states : (nx, ny, nz) uint8 cell states (points in E cells go to their nearest occupied
-        neighbour, see :func:`cells_from_depth`), or a bool cell mask (used as is)
-    spec : GridSpec of ``states``; depth : (H, W) float metres or uint16 raw; camera : Camera
-    Returns (H, W) bool foreground.
-    """
-    states = np.asarray(states)
-    if states.dtype == np.bool_:
-        if states.shape != spec.shape:
-            raise ValueError(f"cell mask must have the grid's shape {spec.shape}, got {states.shape}")
-        mask, index = states, cells_from_depth(depth, camera, spec)
-    else:
-        mask = _check_states(states, spec) == M
-        index = cells_from_depth(depth, camera, spec, states)
-    return np.where(index >= 0, mask.reshape(-1)[np.maximum(index, 0)], False)
-
-
 # ------------------------------------------------------------------------- the grid
 
 

@@ -276,29 +276,3 @@ def predicted_from_tracks(states: Mapping[int, TrackState], previous: Mapping[in
         elif len(state.points):
             bodies[tid] = distance_to_points(state.points, reach=reach)
     return bodies
-
-
-def persons_from_tracks(assigned: Sequence[np.ndarray], truth: Sequence[np.ndarray]) -> dict[int, int]:
-    """Ground-truth person of each track id by majority overlap (for scoring).
-
-    assigned : sequence of (H, W) int track-id images (0 = nobody), e.g. over frames and cameras
-    truth : sequence of (H, W) int person-id images of the same shapes (0 = nobody)
-    Returns ``{track_id: person_id}`` for every track id that overlaps some person; the
-    person is the one sharing the most pixels with the track over all the images.
-    """
-    assigned, truth = list(assigned), list(truth)
-    if len(assigned) != len(truth) or any(np.shape(a) != np.shape(t) for a, t in zip(assigned, truth)):
-        raise ValueError("assigned and truth must be sequences of label images of matching shapes")
-    if not assigned:
-        return {}
-    tracks = np.concatenate([np.asarray(a).reshape(-1) for a in assigned]).astype(np.int64)
-    people = np.concatenate([np.asarray(t).reshape(-1) for t in truth]).astype(np.int64)
-    both = (tracks > 0) & (people > 0)
-    tracks, people = tracks[both], people[both]
-    if tracks.size == 0:
-        return {}
-    pairs, counts = np.unique(tracks * (people.max() + 1) + people, return_counts=True)
-    track_of, person_of = np.divmod(pairs, people.max() + 1)
-    order = np.lexsort((-counts, track_of))  # by track, most shared pixels first
-    first = np.unique(track_of[order], return_index=True)[1]
-    return {int(track_of[order][i]): int(person_of[order][i]) for i in first}

@@ -82,12 +82,12 @@ def start_candidates(model: BodyModel, centroid: np.ndarray, headings: np.ndarra
     standing and (for models with legs) sitting on a seat ``seat_share`` of the stature
     high, at every heading of ``headings`` (radians), the pelvis above the centroid."""
     poses = []
-    postures = [procedural.standing_pose((0.0, 0.0), 0.0, model.dims)]
+    postures = [procedural.stance((0.0, 0.0), 0.0, model.dims)]
     if any("knee" in n for n in model.dof_names):
         standing = postures[0]
         postures.append(procedural.sit_down(standing, seat_share * model.dims.height, dims=model.dims)[-1])
     for posture in postures:
-        fitted = pose_from_joints(model, procedural.joints_from_pose(posture[None], model.dims)[0])
+        fitted = pose_from_joints(model, procedural.joints_from_procedural(posture[None], model.dims)[0])
         for heading in headings:
             pose = fitted.copy()
             pose[model.dof_names.index("heading")] = heading

@@ -12,7 +12,7 @@ some camera's view, hidden or not; ground-truth rows are written only for presen
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -134,34 +134,4 @@ def write_scenario(scenario: Scenario, out: str | Path, seed: int = 0, num_frame
             if progress is not None:
                 progress(1)
         writer.write_groundtruth(gt, vis, person_ids=list(range(1, num_people + 1)))
-    return out
-
-
-#: Renderer part labels of the upper body (head, chest, pelvis, arms and hands): the second
-#: paper thresholds its top-view images to these pixels for its upper-body model.
-UPPER_BODY_PARTS = tuple(PARTS.index(name) for name in (
-    "head", "chest", "pelvis", "left_upper_arm", "left_forearm", "left_hand",
-    "right_upper_arm", "right_forearm", "right_hand"))
-
-
-def person_observations(scenario: Scenario, num_frames: int, *, person: int = 1, parts: Sequence[int] | None = None,
-                        max_points: int = 1000, seed: int = 0) -> list:
-    """One person's likelihood observations straight from the renderer (no stages 1-2).
-
-    For testing and benchmarking stage 3 alone: each of the first ``num_frames`` frames
-    gives an :class:`occupose.likelihood.Observation` of the first camera, the person's
-    pixels taken from the renderer's person-id image (person ids from 1), with
-    with ``parts`` only those of these part labels (e.g. :data:`UPPER_BODY_PARTS`);
-    ``max_points`` points.
-    """
-    from occupose.likelihood import View, observation_from_views
-
-    camera = scenario.cameras[0]
-    out = []
-    for frame in frames(scenario, seed=seed, num_frames=num_frames):
-        rendered = frame.rendered[camera.name]
-        mask = rendered.person == person
-        if parts is not None:
-            mask &= np.isin(rendered.part, parts)
-        out.append(observation_from_views([View(camera, frame.depth[camera.name], mask)], max_points=max_points))
     return out

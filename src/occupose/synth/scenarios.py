@@ -26,9 +26,10 @@ import numpy as np
 from occupose.body.dims import BodyDims, DEFAULT_DIMS, dims_from_joints
 from occupose.camera import Camera, camera_preset, look_at, sensor_spec
 from occupose.joints import JOINT_INDEX as J
-from occupose.io.mocap import canonical_from_clip, facing_from_joints as facing, find_clip, load_clip, place, resample
+from occupose.io.mocap import canonical_from_clip, find_clip, load_clip
 from occupose.synth import motion as pm
 from occupose.synth.body import BodyShape, random_body_shape
+from occupose.synth.retarget import facing_from_joints as facing, place, resample
 from occupose.geometry.primitives import Primitives, concat
 from occupose.synth.scene import chair, cabinet, couch, room, table
 from occupose.synth.sequence import chain
@@ -93,7 +94,7 @@ class _Motion:
         self.use_mocap = use_mocap
         self.dims = dims
         self.start = (start_xy, heading)
-        self.segments: list[np.ndarray] = [pm.joints_from_pose(pm.standing_pose(start_xy, heading, dims)[None], dims)]
+        self.segments: list[np.ndarray] = [pm.joints_from_procedural(pm.stance(start_xy, heading, dims)[None], dims)]
         #: per segment, the procedural actions that build it (None: a clip or given joints)
         self.actions: list[Callable[[pm.MotionBuilder], pm.MotionBuilder] | None] = [None]
         self.headings: list[float | None] = [None]
@@ -116,7 +117,7 @@ class _Motion:
     def _resize(self, dims: BodyDims) -> None:
         """Go on with ``dims``: the start pose and every procedural segment so far rebuilt."""
         self.dims = dims
-        self.segments[0] = pm.joints_from_pose(pm.standing_pose(*self.start, dims)[None], dims)
+        self.segments[0] = pm.joints_from_procedural(pm.stance(*self.start, dims)[None], dims)
         for i, actions in enumerate(self.actions):
             if actions is not None:
                 self.segments[i] = actions(self._builder(self.segments[i - 1])).joints()[1:]
@@ -322,7 +323,7 @@ def _moved_chair(rng, use_mocap, sensor):
     for base in (pm.LEFT, pm.RIGHT):
         for dof, angle in ((pm.SHOULDER_FLEX, 0.55), (pm.SHOULDER_ABD, 0.1), (pm.ELBOW, 0.4)):
             poses[:, base + dof] += ramp * (angle - poses[:, base + dof])
-    joints = pm.joints_from_pose(poses, dims)
+    joints = pm.joints_from_procedural(poses, dims)
     n = 600
     chair_xy = np.empty((n, 2))
     chair_heading = np.full(n, math.pi)  # its back rest towards the person coming from +x

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from occupose.joints import JOINT_INDEX as J
-from occupose.io.mocap import facing_from_joints as facing
+from occupose.synth.retarget import facing_from_joints as facing
 
 
 def rigid_z(joints: np.ndarray, angle: float, pivot_xy, to_xy) -> np.ndarray:

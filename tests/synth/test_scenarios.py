@@ -35,7 +35,7 @@ def rendered():
 
 
 def test_body_primitives_follow_the_joints(rng):
-    joints = pm.joints_from_pose(pm.standing_pose((1.0, 2.0), 0.3)[None])[0]
+    joints = pm.joints_from_procedural(pm.stance((1.0, 2.0), 0.3)[None])[0]
     prims = primitives_from_joints(joints, random_body_shape(rng), person=3)
     assert len(prims) == 16 and np.all(prims.person == 3)
     assert set(prims.part) == set(range(1, 16))  # every body part is drawn

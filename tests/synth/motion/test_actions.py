@@ -1,27 +1,16 @@
-"""Procedural motion: skeleton geometry, the gait, sitting, arm motions and chaining."""
+"""Procedural actions: the gait, turning, standing, sitting, arm motions, keyframes."""
 
 import math
 
 import numpy as np
 import pytest
 
-from occupose.body.dims import BodyDims, bone_lengths_from_dims, dims_from_joints
-from occupose.joints import BONES, JOINT_INDEX as J
+from occupose.body.dims import BodyDims
+from occupose.synth.retarget import facing_from_joints as facing
+from occupose.joints import JOINT_INDEX as J
 from occupose.synth import motion as m
 
 FPS = 30.0
-
-
-def bone_lengths(joints):
-    a = np.array([b[0] for b in BONES])
-    b = np.array([b[1] for b in BONES])
-    return np.linalg.norm(joints[..., b, :] - joints[..., a, :], axis=-1)
-
-
-def facing(joints):
-    """Heading from (left_hip - right_hip) x up, radians."""
-    lr = joints[..., J["left_hip"], :] - joints[..., J["right_hip"], :]
-    return np.arctan2(-lr[..., 0], lr[..., 1])
 
 
 def angle_diff(a, b):
@@ -29,148 +18,11 @@ def angle_diff(a, b):
 
 
 @pytest.fixture(scope="module")
-def script():
-    """A chained scene: walk round a corner, sit, gesture, stand, wave, walk back."""
-    b = m.MotionBuilder((0.0, 0.0), heading=0.0, fps=FPS)
-    b.walk([(3.0, 0.0), (3.0, 2.0)], speed=1.3).turn(-math.pi / 2).sit_down(0.45, 1.8).sitting(1.0)
-    b.gesture("cross", duration=2.0).wave("left", 2.0, 2).stand_up(1.8).stand(1.0).walk([(0.0, 0.0)], 1.0)
-    return b
-
-
-@pytest.fixture(scope="module")
 def straight():
     """Poses and joints of a 6 m walk along +x at 1.3 m/s, start frame included."""
-    start = m.standing_pose((0.0, 0.0), 0.0)
+    start = m.stance((0.0, 0.0), 0.0)
     poses = np.vstack([start, m.walk(start, [(6.0, 0.0)], 1.3, fps=FPS)])
-    return poses, m.joints_from_pose(poses)
-
-
-# ---------------------------------------------------------------------------------------
-# body and kinematics
-
-
-def test_default_body_is_an_average_adult():
-    dims = BodyDims()
-    assert dims.height == pytest.approx(1.72)
-    j = m.joints_from_pose(m.standing_pose())
-    assert dims.hip_height == pytest.approx(0.92)
-    assert j[J["left_hip"], 2] == pytest.approx(dims.hip_height, abs=1e-3)  # the knees barely bent
-    assert j.shape == (15, 3) and j.dtype == np.float64
-    assert j[J["left_ankle"], 2] == pytest.approx(0.08, abs=1e-9)
-    assert j[J["pelvis"], 2] == pytest.approx(0.92, abs=0.005)
-    assert j[J["head"], 2] - j[J["neck"], 2] == pytest.approx(0.11)
-    assert j[J["head"], 2] + dims.neck_head == pytest.approx(1.72, abs=0.005)  # top of the head
-    # pelvis is the midpoint of the hips
-    np.testing.assert_allclose(j[J["pelvis"]], 0.5 * (j[J["left_hip"]] + j[J["right_hip"]]), atol=1e-12)
-
-
-def test_scaled_body_keeps_proportions():
-    small = BodyDims().scaled(1.55)
-    assert small.height == pytest.approx(1.55)
-    assert small.thigh / small.shin == pytest.approx(BodyDims().thigh / BodyDims().shin)
-    with pytest.raises(ValueError, match="height"):
-        BodyDims().scaled(17.2)
-    with pytest.raises(ValueError, match="thigh"):
-        BodyDims(thigh=-0.4)
-
-
-def test_left_is_left_of_the_facing_direction():
-    j = m.joints_from_pose(m.standing_pose((1.0, 2.0), heading=math.pi / 2))  # facing +y
-    assert j[J["left_hip"], 0] < j[J["right_hip"], 0]
-    assert j[J["left_shoulder"], 0] < j[J["right_shoulder"], 0]
-    assert j[J["left_ankle"], 0] < j[J["right_ankle"], 0]
-    for heading in (0.0, 0.7, -2.5, 3.0):
-        assert angle_diff(facing(m.joints_from_pose(m.standing_pose(heading=heading))), heading) < 1e-9
-
-
-def test_pose_angle_conventions():
-    base = m.standing_pose()
-    j0 = m.joints_from_pose(base)
-
-    def moved(**values):
-        return m.joints_from_pose(m.pose_with(base, **values))
-
-    # facing +x: forward is +x, left is +y, up is +z
-    assert moved(right_shoulder_flex=math.pi / 2)[J["right_wrist"], 0] > 0.5   # arm forward
-    assert moved(left_shoulder_abd=math.pi / 2)[J["left_wrist"], 1] > 0.7      # arm out to the left
-    assert moved(right_shoulder_abd=math.pi / 2)[J["right_wrist"], 1] < -0.7   # arm out to the right
-    assert moved(left_shoulder_flex=math.pi)[J["left_wrist"], 2] > 1.9          # arm straight up
-    assert moved(trunk_lean=0.5)[J["neck"], 0] > 0.2                             # leaning forward
-    assert moved(trunk_side=0.3)[J["neck"], 1] > 0.1                             # leaning left
-    assert moved(left_hip_flex=math.pi / 2)[J["left_ankle"], 0] > 0.8            # leg forward
-    bent = moved(left_knee=1.0)
-    assert bent[J["left_ankle"], 0] < bent[J["left_knee"], 0]                    # shin goes back
-    up = moved(left_shoulder_abd=math.pi / 2, left_elbow=math.pi / 2, left_shoulder_rot=math.pi / 2)
-    assert up[J["left_wrist"], 2] - up[J["left_elbow"], 2] == pytest.approx(0.25, abs=0.02)  # forearm up
-    across = moved(right_elbow=math.pi / 2, right_shoulder_rot=-math.pi / 2)
-    assert across[J["right_wrist"], 1] > j0[J["right_elbow"], 1] + 0.2           # forearm across the body
-    # the same numbers on both sides mirror the pose about the sagittal plane
-    mirror = moved(left_shoulder_flex=0.4, left_shoulder_abd=0.3, left_shoulder_rot=0.5, left_elbow=1.0,
-                   right_shoulder_flex=0.4, right_shoulder_abd=0.3, right_shoulder_rot=0.5, right_elbow=1.0)
-    np.testing.assert_allclose(mirror[J["left_wrist"]] * [1, -1, 1], mirror[J["right_wrist"]], atol=1e-12)
-
-
-def test_joints_from_pose_batches_and_checks_shape():
-    poses = np.stack([m.standing_pose(heading=h) for h in (0.0, 1.0, 2.0)])
-    batch = m.joints_from_pose(poses.reshape(3, 1, -1))
-    assert batch.shape == (3, 1, 15, 3)
-    np.testing.assert_allclose(batch[1, 0], m.joints_from_pose(poses[1]), atol=1e-12)
-    with pytest.raises(ValueError, match=r"\(\.\.\., 22\)"):
-        m.joints_from_pose(np.zeros((4, 21)))
-    with pytest.raises(ValueError, match="unknown pose entry 'knee'"):
-        m.pose_with(m.standing_pose(), knee=0.3)
-
-
-def test_leg_inverse_kinematics_round_trip(rng):
-    dims = BodyDims()
-    n = 200
-    poses = np.repeat(m.standing_pose()[None], n, axis=0)
-    poses[:, m.HEADING] = rng.uniform(-np.pi, np.pi, n)
-    poses[:, m.LEFT + m.HIP_FLEX] = rng.uniform(-0.5, 1.6, n)
-    poses[:, m.LEFT + m.HIP_ABD] = rng.uniform(-0.3, 0.5, n)
-    poses[:, m.LEFT + m.KNEE] = rng.uniform(0.05, 2.0, n)
-    j = m.joints_from_pose(poses, dims)
-    angles = m._leg_angles(j[:, J["left_hip"]], j[:, J["left_ankle"]], poses[:, m.HEADING], 1.0, dims)
-    np.testing.assert_allclose(angles, poses[:, m.LEFT + m.HIP_FLEX:m.LEFT + m.KNEE + 1], atol=1e-9)
-
-
-def test_bone_lengths_are_constant_and_equal_dims(script):
-    for dims in (BodyDims(), BodyDims().scaled(1.58)):
-        b = m.MotionBuilder((0.0, 0.0), dims=dims).walk([(2.0, 1.0)]).sit_down(0.42).wave("both").stand_up()
-        lengths = bone_lengths(b.joints())
-        np.testing.assert_allclose(lengths, np.broadcast_to(bone_lengths_from_dims(dims), lengths.shape),
-                                   atol=1e-6)
-    lengths = bone_lengths(script.joints())
-    assert np.ptp(lengths, axis=0).max() < 1e-6
-
-
-def test_dims_from_joints_recovers_the_body():
-    dims = BodyDims().scaled(1.85)
-    joints = m.MotionBuilder(dims=dims).walk([(3.0, 0.0)]).joints()
-    found = dims_from_joints(joints)
-    for name in ("pelvis_width", "spine", "neck_head", "shoulder_width", "shoulder_drop",
-                 "upper_arm", "forearm", "thigh", "shin", "ankle_height", "seat_clearance"):
-        assert getattr(found, name) == pytest.approx(getattr(dims, name), abs=1e-6), name
-    with pytest.raises(ValueError, match=r"\(T, 15, 3\)"):
-        dims_from_joints(joints[0])
-
-
-@pytest.mark.shared
-def test_dims_from_a_real_clip_drive_the_procedural_skeleton(mocap):
-    from occupose.io import mocap as mocap_io
-
-    path = mocap / "bandai1" / "dataset-1_walk_normal_001.bvh"
-    if not path.exists():
-        pytest.skip(f"{path.name} not in the shared data")
-    clip = mocap_io.canonical_from_clip(mocap_io.load_clip(path))
-    dims = dims_from_joints(clip)
-    assert 1.4 < dims.height < 2.0
-    assert 0.2 < dims.upper_arm < 0.35 and 0.35 < dims.thigh < 0.5
-    np.testing.assert_allclose(np.median(bone_lengths(clip)[:, [3, 9, 10]], axis=0),
-                               [dims.upper_arm, dims.thigh, dims.shin], atol=0.01)
-    joints = m.MotionBuilder(dims=dims).walk([(2.0, 0.0)]).sit_down(0.45).joints()
-    np.testing.assert_allclose(bone_lengths(joints), np.broadcast_to(bone_lengths_from_dims(dims),
-                                                                     (len(joints), len(BONES))), atol=1e-6)
+    return poses, m.joints_from_procedural(poses)
 
 
 # ---------------------------------------------------------------------------------------
@@ -188,7 +40,7 @@ def test_walk_moves_along_the_path_at_the_requested_speed(straight):
     duration = (len(poses) - 1) / FPS
     assert 6.0 / 1.3 < duration < 6.0 / 1.3 + 1.2      # plus speeding up, braking, closing the feet
     for speed_request in (0.9, 1.6):
-        p = m.walk(m.standing_pose(), [(6.0, 0.0)], speed_request)
+        p = m.walk(m.stance(), [(6.0, 0.0)], speed_request)
         v = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1) * FPS
         assert np.mean(v[45:-45]) == pytest.approx(speed_request, rel=0.05)
 
@@ -235,9 +87,9 @@ def test_walking_feet_stay_on_the_floor_and_do_not_slide(straight):
 
 
 def test_heading_follows_the_path():
-    start = m.standing_pose((0.0, 0.0), 0.0)
+    start = m.stance((0.0, 0.0), 0.0)
     poses = m.walk(start, [(3.0, 0.0), (3.0, 3.0)], 1.2)
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     pelvis = j[:, J["pelvis"], :2]
     assert angle_diff(facing(j[-1]), np.pi / 2) < 1e-6
     velocity = np.gradient(pelvis, axis=0)
@@ -248,7 +100,7 @@ def test_heading_follows_the_path():
     assert np.abs(np.diff(poses[:, m.HEADING])).max() * FPS < 3.5
     # a walk starting the wrong way turns on the spot first, towards the path
     back = m.walk(start, [(-3.0, 0.0)], 1.2)
-    jb = m.joints_from_pose(back)
+    jb = m.joints_from_procedural(back)
     turning = np.flatnonzero(np.linalg.norm(jb[:, J["pelvis"], :2], axis=1) < 1e-9)
     assert len(turning) > 15
     assert angle_diff(facing(jb[turning[-1]]), np.pi) < 1e-6
@@ -256,7 +108,7 @@ def test_heading_follows_the_path():
 
 
 def test_walk_rejects_bad_paths_and_speeds():
-    start = m.standing_pose()
+    start = m.stance()
     with pytest.raises(ValueError, match=r"path_xy must be finite waypoints of shape \(K, 2\)"):
         m.walk(start, [1.0, 2.0])
     with pytest.raises(ValueError, match="lead away from the start"):
@@ -271,9 +123,9 @@ def test_walk_rejects_bad_paths_and_speeds():
 
 
 def test_turn_steps_round_without_sliding():
-    start = m.standing_pose((1.0, 1.0), 0.5)
+    start = m.stance((1.0, 1.0), 0.5)
     poses = np.vstack([start, m.turn(start, 0.5 - 2.8, fps=FPS)])
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     assert angle_diff(facing(j[-1]), 0.5 - 2.8) < 1e-9
     np.testing.assert_allclose(j[:, J["pelvis"], :2], 1.0, atol=1e-12)
     for side in ("left", "right"):
@@ -291,7 +143,7 @@ def test_turn_steps_round_without_sliding():
 
 def test_sitting_down_puts_the_pelvis_on_the_seat():
     dims = BodyDims()
-    start = m.standing_pose((0.0, 0.0), heading=math.pi)   # facing -x: the seat is towards +x
+    start = m.stance((0.0, 0.0), heading=math.pi)   # facing -x: the seat is towards +x
     b = m.MotionBuilder(start_pose=start).sit_down(0.45, 1.8).sitting(2.0)
     j = b.joints()
     seated = j[b.segments()[1].start:b.segments()[1].stop]
@@ -312,7 +164,7 @@ def test_sitting_down_puts_the_pelvis_on_the_seat():
 
 
 def test_standing_up_returns_to_the_standing_pose():
-    start = m.standing_pose((2.0, -1.0), heading=0.3)
+    start = m.stance((2.0, -1.0), heading=0.3)
     b = m.MotionBuilder(start_pose=start).sit_down(0.5).stand_up(1.8)
     np.testing.assert_allclose(b.pose, start, atol=1e-9)
     lean = b.poses()[b.segments()[1].start:, m.TRUNK_LEAN]
@@ -321,24 +173,24 @@ def test_standing_up_returns_to_the_standing_pose():
 
 def test_seat_height_and_start_pose_are_checked():
     with pytest.raises(ValueError, match=r"seat_height must be in \["):
-        m.sit_down(m.standing_pose(), seat_height=0.9)
+        m.sit_down(m.stance(), seat_height=0.9)
     with pytest.raises(ValueError, match="call sit_down first"):
-        m.stand_up(m.standing_pose())
+        m.stand_up(m.stance())
     with pytest.raises(ValueError, match="call sit_down first"):
-        m.sitting(m.standing_pose(), 1.0)
+        m.sitting(m.stance(), 1.0)
     with pytest.raises(ValueError, match="call stand_up first"):
-        m.sit_down(m.sit_down(m.standing_pose())[-1])
+        m.sit_down(m.sit_down(m.stance())[-1])
 
 
 def test_idle_standing_sways_a_little_and_ends_where_it_started():
-    start = m.standing_pose()
+    start = m.stance()
     poses = m.stand(start, 4.0)
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     shift = np.linalg.norm(j[:, J["pelvis"], :2], axis=1)
     assert 0.003 < shift.max() < 0.03
     np.testing.assert_allclose(poses[-1], start, atol=1e-9)
     ankles = j[:, [J["left_ankle"], J["right_ankle"]]]
-    np.testing.assert_allclose(ankles, np.broadcast_to(m.joints_from_pose(start)[[J["left_ankle"], J["right_ankle"]]],
+    np.testing.assert_allclose(ankles, np.broadcast_to(m.joints_from_procedural(start)[[J["left_ankle"], J["right_ankle"]]],
                                                        ankles.shape), atol=1e-6)
 
 
@@ -348,9 +200,9 @@ def test_idle_standing_sways_a_little_and_ends_where_it_started():
 
 @pytest.mark.parametrize("arm", ["left", "right", "both"])
 def test_wave_raises_the_wrist_above_the_shoulder(arm):
-    start = m.standing_pose()
+    start = m.stance()
     poses = m.wave(start, arm, duration=2.5, cycles=3)
-    j = m.joints_from_pose(poses)
+    j = m.joints_from_procedural(poses)
     middle = slice(20, -20)
     sides = ("left", "right") if arm == "both" else (arm,)
     for side in ("left", "right"):
@@ -368,13 +220,13 @@ def test_wave_raises_the_wrist_above_the_shoulder(arm):
 
 
 def test_gestures():
-    start = m.standing_pose()
-    j0 = m.joints_from_pose(start)
+    start = m.stance()
+    j0 = m.joints_from_procedural(start)
 
     def held(name, arm="right"):
         poses = m.gesture(start, name, arm, duration=2.0)
         np.testing.assert_allclose(poses[-1], start, atol=1e-12)
-        return m.joints_from_pose(poses[len(poses) // 2])
+        return m.joints_from_procedural(poses[len(poses) // 2])
 
     assert held("raise")[J["right_wrist"], 2] > j0[J["head"], 2] + 0.2
     point = held("point", "left")
@@ -390,11 +242,11 @@ def test_gestures():
 
 
 # ---------------------------------------------------------------------------------------
-# keyframes and chaining
+# keyframes
 
 
 def test_keyframes_interpolate_smoothly_through_the_keys():
-    start = m.standing_pose()
+    start = m.stance()
     key1 = m.pose_with(start, right_shoulder_flex=1.2, x=0.2)
     key2 = m.pose_with(start, right_shoulder_flex=0.4, x=0.3)
     for interpolation in m.INTERPOLATIONS:
@@ -412,40 +264,10 @@ def test_keyframes_interpolate_smoothly_through_the_keys():
         m.keyframes(start, [1.0], [key1], "linear")
 
 
-def test_chained_actions_have_no_jumps(script):
-    j = script.joints()
-    assert j.shape == (script.num_frames, 15, 3) and j.dtype == np.float64
-    step = np.linalg.norm(np.diff(j, axis=0), axis=2)
-    assert step.max() < 0.15                                     # < 4.5 m/s at 30 fps
-    # poses stay continuous across the boundaries between actions
-    for seg in script.segments()[1:]:
-        assert step[seg.start - 1].max() < 0.1
-    assert j[..., 2].min() > 0.05 - 1e-9                         # nothing under the floor but feet above 5 cm
-
-
-def test_segments_cover_all_frames(script):
-    segments = script.segments()
-    assert [s.name for s in segments] == ["walk", "turn", "sit_down", "sitting", "gesture:cross", "wave",
-                                          "stand_up", "stand", "walk"]
-    assert segments[0].start == 0 and segments[-1].stop == script.num_frames
-    assert all(a.stop == b.start for a, b in zip(segments, segments[1:]))
-    sitting = segments[3]
-    pelvis = script.joints()[sitting.start:sitting.stop, J["pelvis"], 2]
-    assert np.all(pelvis < 0.6)
-    assert script.poses().shape == (script.num_frames, m.POSE_SIZE)
-
-
-def test_motion_is_deterministic(script):
-    again = m.MotionBuilder((0.0, 0.0), heading=0.0, fps=FPS)
-    again.walk([(3.0, 0.0), (3.0, 2.0)], speed=1.3).turn(-math.pi / 2).sit_down(0.45, 1.8).sitting(1.0)
-    again.gesture("cross", duration=2.0).wave("left", 2.0, 2).stand_up(1.8).stand(1.0).walk([(0.0, 0.0)], 1.0)
-    np.testing.assert_array_equal(again.joints(), script.joints())
-
-
 def test_frame_rate_sets_the_frame_count():
     for fps in (15.0, 30.0, 60.0):
-        assert m.stand(m.standing_pose(), 2.0, fps=fps).shape == (int(2 * fps), m.POSE_SIZE)
+        assert m.stand(m.stance(), 2.0, fps=fps).shape == (int(2 * fps), m.POSE_SIZE)
     with pytest.raises(ValueError, match="fps must be a positive number"):
         m.MotionBuilder(fps=0)
     with pytest.raises(ValueError, match="duration must be a positive number"):
-        m.stand(m.standing_pose(), -1.0)
+        m.stand(m.stance(), -1.0)

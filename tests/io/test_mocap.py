@@ -7,6 +7,7 @@ import pytest
 
 from occupose.io import mocap as mc
 from occupose.joints import BONES, JOINT_INDEX as J, JOINTS
+from occupose.synth.retarget import facing_from_joints
 
 # ---------------------------------------------------------------------------------------
 # Tiny hand-written BVH files: hand-computed positions
@@ -202,7 +203,7 @@ def test_malformed_amc_names_file_and_line(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------
-# Canonical joints and operations on synthetic arrays
+# Canonical joints and measurements on synthetic arrays
 
 
 def _standing(facing_y=True):
@@ -215,50 +216,6 @@ def _standing(facing_y=True):
         "right_hip": (0.09, 0, 0.95), "right_knee": (0.10, 0, 0.52), "right_ankle": (0.10, 0, 0.08),
     }
     return np.array([p[name] for name in JOINTS], dtype=np.float64)
-
-
-def _rotz(points, angle):
-    c, s = math.cos(angle), math.sin(angle)
-    return points @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]).T
-
-
-def test_facing_from_joints_follows_rotation_about_z():
-    body = _standing()
-    assert mc.facing_from_joints(body) == pytest.approx(math.pi / 2)
-    angles = np.array([0.3, -2.0, 3.0])
-    bodies = np.stack([_rotz(body, a) for a in angles])
-    expected = np.angle(np.exp(1j * (math.pi / 2 + angles)))
-    np.testing.assert_allclose(mc.facing_from_joints(bodies), expected, atol=1e-12)
-
-
-def test_place_puts_pelvis_heading_and_ankles(rng):
-    base = _rotz(_standing(), 1.1) + [4.0, -3.0, 0.37]
-    walk = np.linspace(0, 1, 45)[:, None, None] * [0.5, 0.2, 0.0]
-    sway = np.zeros((45, 15, 3))
-    sway[:, J["left_ankle"], 2] = 0.05 * np.sin(np.arange(45) / 3.0) ** 2
-    joints = base + walk + sway
-    out = mc.place(joints, start_xy=(2.0, -1.0), heading=math.pi, fps=30.0)
-    assert out.shape == joints.shape
-    np.testing.assert_allclose(out[0, J["pelvis"], :2], [2.0, -1.0], atol=1e-12)
-    assert abs(np.angle(np.exp(1j * (mc.facing_from_joints(out[0]) - math.pi)))) < 1e-9
-    ankles = out[:30, [J["left_ankle"], J["right_ankle"]], 2]
-    assert ankles.min() == pytest.approx(mc.ANKLE_HEIGHT)
-    np.testing.assert_allclose(mc.bone_lengths(out), mc.bone_lengths(joints), atol=1e-12)
-    with pytest.raises(ValueError, match="start_xy"):
-        mc.place(joints, start_xy=(1.0, 2.0, 3.0))
-
-
-def test_resample_is_exact_on_linear_motion(rng):
-    v = rng.normal(size=(15, 3))
-    joints = np.arange(121)[:, None, None] / 120.0 * v + rng.normal(size=(15, 3))  # 1 s at 120 fps
-    down = mc.resample(joints, 120.0, 30.0)
-    assert down.shape == (31, 15, 3)
-    np.testing.assert_allclose(down, joints[::4], atol=1e-12)
-    up = mc.resample(down, 30.0, 45.0)
-    assert up.shape == (46, 15, 3)
-    np.testing.assert_allclose(up, np.arange(46)[:, None, None] / 45.0 * v + joints[0], atol=1e-12)
-    with pytest.raises(ValueError, match="positive"):
-        mc.resample(joints, 0.0, 30.0)
 
 
 def test_bone_lengths_and_standing_height():
@@ -408,9 +365,9 @@ def test_bandai_left_right_and_turn_direction(mocap):
     assert wave_left[:, J["left_wrist"], 2].max() > wave_left[:, J["head"], 2].max()
     assert wave_left[:, J["right_wrist"], 2].max() < wave_left[:, J["pelvis"], 2].max()
     turn = load("bandai2", "dataset-2_walk-turn-left_active_001")
-    facing = np.unwrap(mc.facing_from_joints(turn))
+    facing = np.unwrap(facing_from_joints(turn))
     assert math.radians(60) < facing[-1] - facing[0] < math.radians(120)  # a left turn is counterclockwise
     walk = load("bandai1", "dataset-1_walk_normal_001")
     step = walk[30, J["pelvis"], :2] - walk[0, J["pelvis"], :2]
-    heading = mc.facing_from_joints(walk[0])
+    heading = facing_from_joints(walk[0])
     assert np.dot(step, [math.cos(heading), math.sin(heading)]) > 0.9 * np.linalg.norm(step)  # walks forward

@@ -1,0 +1,66 @@
+"""Tests of occupose.synth.retarget: retiming, facing and placing canonical sequences (synthetic arrays)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from occupose.io.mocap import ANKLE_HEIGHT, bone_lengths
+from occupose.joints import JOINT_INDEX as J, JOINTS
+from occupose.synth import retarget as rt
+
+
+def _standing(facing_y=True):
+    """A standing canonical skeleton facing +y (left side at smaller x), metres, z up."""
+    p = {
+        "head": (0, 0, 1.60), "neck": (0, 0, 1.45), "pelvis": (0, 0, 0.95),
+        "left_shoulder": (-0.18, 0, 1.42), "left_elbow": (-0.20, 0, 1.12), "left_wrist": (-0.21, 0, 0.86),
+        "right_shoulder": (0.18, 0, 1.42), "right_elbow": (0.20, 0, 1.12), "right_wrist": (0.21, 0, 0.86),
+        "left_hip": (-0.09, 0, 0.95), "left_knee": (-0.10, 0, 0.52), "left_ankle": (-0.10, 0, 0.08),
+        "right_hip": (0.09, 0, 0.95), "right_knee": (0.10, 0, 0.52), "right_ankle": (0.10, 0, 0.08),
+    }
+    return np.array([p[name] for name in JOINTS], dtype=np.float64)
+
+
+def _rotz(points, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return points @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]).T
+
+
+def test_facing_from_joints_follows_rotation_about_z():
+    body = _standing()
+    assert rt.facing_from_joints(body) == pytest.approx(math.pi / 2)
+    angles = np.array([0.3, -2.0, 3.0])
+    bodies = np.stack([_rotz(body, a) for a in angles])
+    expected = np.angle(np.exp(1j * (math.pi / 2 + angles)))
+    np.testing.assert_allclose(rt.facing_from_joints(bodies), expected, atol=1e-12)
+
+
+def test_place_puts_pelvis_heading_and_ankles(rng):
+    base = _rotz(_standing(), 1.1) + [4.0, -3.0, 0.37]
+    walk = np.linspace(0, 1, 45)[:, None, None] * [0.5, 0.2, 0.0]
+    sway = np.zeros((45, 15, 3))
+    sway[:, J["left_ankle"], 2] = 0.05 * np.sin(np.arange(45) / 3.0) ** 2
+    joints = base + walk + sway
+    out = rt.place(joints, start_xy=(2.0, -1.0), heading=math.pi, fps=30.0)
+    assert out.shape == joints.shape
+    np.testing.assert_allclose(out[0, J["pelvis"], :2], [2.0, -1.0], atol=1e-12)
+    assert abs(np.angle(np.exp(1j * (rt.facing_from_joints(out[0]) - math.pi)))) < 1e-9
+    ankles = out[:30, [J["left_ankle"], J["right_ankle"]], 2]
+    assert ankles.min() == pytest.approx(ANKLE_HEIGHT)
+    np.testing.assert_allclose(bone_lengths(out), bone_lengths(joints), atol=1e-12)
+    with pytest.raises(ValueError, match="start_xy"):
+        rt.place(joints, start_xy=(1.0, 2.0, 3.0))
+
+
+def test_resample_is_exact_on_linear_motion(rng):
+    v = rng.normal(size=(15, 3))
+    joints = np.arange(121)[:, None, None] / 120.0 * v + rng.normal(size=(15, 3))  # 1 s at 120 fps
+    down = rt.resample(joints, 120.0, 30.0)
+    assert down.shape == (31, 15, 3)
+    np.testing.assert_allclose(down, joints[::4], atol=1e-12)
+    up = rt.resample(down, 30.0, 45.0)
+    assert up.shape == (46, 15, 3)
+    np.testing.assert_allclose(up, np.arange(46)[:, None, None] / 45.0 * v + joints[0], atol=1e-12)
+    with pytest.raises(ValueError, match="positive"):
+        rt.resample(joints, 0.0, 30.0)
