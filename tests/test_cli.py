@@ -6,7 +6,7 @@ from click.testing import CliRunner
 from PIL import Image
 
 from occupose.cli import main
-from occupose.evaluation.metrics import write_tracks_csv
+from occupose.io.joint_table import write_tracks_csv
 from occupose.io.recording import Recording
 from occupose.synth.scenarios import SCENARIOS
 

@@ -22,12 +22,10 @@ from occupose.evaluation.metrics import (
     match_tracks,
     per_joint_errors,
     pixel_assignment_accuracy,
-    read_tracks_csv,
     rolling_mean,
     score,
     segment_distances,
     table_row,
-    write_tracks_csv,
 )
 
 # 3-4-5 triangles: offsets of length 3, 6 and 9 cm for three joints.
@@ -406,73 +404,6 @@ def test_foreground_scores():
     assert (precision, recall, iou) == pytest.approx((2 / 3, 2 / 4, 2 / 5))
     empty = np.zeros((2, 3), dtype=bool)
     assert all(math.isnan(v) for v in foreground_scores(empty, empty))
-
-
-# --------------------------------------------------------------------------- csv
-
-
-def test_tracks_csv_round_trip(tmp_path, rng):
-    joints = rng.uniform(-3, 3, size=(4, 15, 3))
-    joints[:, 9:] = np.nan
-    joints[2] = np.nan
-    visible = rng.random((4, 15)) < 0.5
-    other = rng.uniform(-3, 3, size=(4, 15, 3))
-    path = tmp_path / "tracks.csv"
-    write_tracks_csv(path, {12: (joints, visible), 3: (other, np.ones((4, 15), bool))})
-    lines = path.read_text().splitlines()
-    assert lines[0] == "frame,track,joint,x,y,z,visible"
-    assert lines[1].startswith("0,3,head,")  # frame, then track, then joint order
-    assert len(lines) == 1 + 4 * 15 + 3 * 9
-
-    tracks = read_tracks_csv(path, num_frames=4)
-    assert sorted(tracks) == [3, 12]
-    read_joints, read_visible = tracks[12]
-    np.testing.assert_allclose(read_joints, joints, atol=5e-7)  # NaN positions match too
-    finite = np.isfinite(joints).all(axis=2)
-    assert np.array_equal(read_visible, visible & finite)
-    np.testing.assert_allclose(tracks[3][0], other, atol=5e-7)
-
-
-@pytest.mark.parametrize(
-    ("text", "message"),
-    [
-        ("frame,track,joint,x,y,z\n", "expected header"),
-        ("", "empty file"),
-        ("frame,track,joint,x,y,z,visible\n0,1,nose,0,0,0,1\n", "unknown joint 'nose'"),
-        ("frame,track,joint,x,y,z,visible\n0,1,head,0,abc,0,1\n", "y must be a number"),
-        ("frame,track,joint,x,y,z,visible\n0,1,head,0,inf,0,1\n", "y must be finite"),
-        ("frame,track,joint,x,y,z,visible\n0,1,head,0,0,1\n", "expected 7 columns, got 6"),
-        ("frame,track,joint,x,y,z,visible\n0.5,1,head,0,0,0,1\n", "frame must be an integer"),
-        ("frame,track,joint,x,y,z,visible\n7,1,head,0,0,0,1\n", "frame 7 outside 0..4"),
-        ("frame,track,joint,x,y,z,visible\n0,1,head,0,0,0,2\n", "visible must be 0 or 1"),
-        ("frame,track,joint,x,y,z,visible\n0,1,head,0,0,0,1\n0,1,head,1,0,0,1\n", "repeated row"),
-    ],
-)
-def test_read_tracks_csv_errors_name_file_and_line(tmp_path, text, message):
-    path = tmp_path / "bad_tracks.csv"
-    path.write_text(text)
-    with pytest.raises(ValueError, match=message) as info:
-        read_tracks_csv(path, num_frames=5)
-    assert "bad_tracks.csv" in str(info.value)
-
-
-def test_read_tracks_csv_missing_file_and_empty_tracks(tmp_path):
-    with pytest.raises(FileNotFoundError, match="nothing.csv"):
-        read_tracks_csv(tmp_path / "nothing.csv", num_frames=5)
-    path = tmp_path / "tracks.csv"
-    path.write_text("frame,track,joint,x,y,z,visible\n")
-    assert read_tracks_csv(path, num_frames=5) == {}
-
-
-def test_write_tracks_csv_checks_input(tmp_path):
-    joints = np.zeros((2, 15, 3))
-    visible = np.ones((2, 15), dtype=bool)
-    with pytest.raises(ValueError, match="same number of frames"):
-        write_tracks_csv(tmp_path / "t.csv", {1: (joints, visible), 2: (joints[:1], visible[:1])})
-    with pytest.raises(ValueError, match="integers"):
-        write_tracks_csv(tmp_path / "t.csv", {"a": (joints, visible)})
-    with pytest.raises(ValueError, match="shape"):
-        write_tracks_csv(tmp_path / "t.csv", {1: (joints[:, :9], visible)})
 
 
 def test_a_track_present_in_one_frame_does_not_steal_the_match():

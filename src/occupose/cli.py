@@ -93,7 +93,7 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
               help="A tracks.csv to draw beside the ground truth.")
 def show_cmd(recording, index, out, tracks) -> None:
     """Write a PNG of one frame: depth colour-mapped, skeletons drawn over it."""
-    from occupose.evaluation.metrics import read_tracks_csv
+    from occupose.io.joint_table import read_tracks_csv
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
@@ -121,7 +121,8 @@ def score_cmd(recording, tracks) -> None:
 
 def score_text(rec, tracks_path: Path) -> str:
     """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person."""
-    from occupose.evaluation.metrics import format_table, read_tracks_csv, score
+    from occupose.evaluation.metrics import format_table, score
+    from occupose.io.joint_table import read_tracks_csv
 
     if not rec.has_groundtruth:
         raise ValueError(f"{rec.path}: no groundtruth.csv, nothing to score against")
@@ -161,7 +162,7 @@ def run_tracking(rec, out: Path, method: str, seed: int, **settings) -> tuple[Pa
     """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json; returns (tracks path, result)."""
     import json
 
-    from occupose.evaluation.metrics import write_tracks_csv
+    from occupose.io.joint_table import write_tracks_csv
     from occupose.tracker import track_recording
 
     out.mkdir(parents=True, exist_ok=True)
@@ -232,7 +233,7 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
 def demo_cmd(out, scenario, frames, method) -> None:
     """Render a built-in scenario with procedural motion (no shared data needed), track it,
     print the Table I row and picture a frame with the skeletons."""
-    from occupose.evaluation.metrics import read_tracks_csv
+    from occupose.io.joint_table import read_tracks_csv
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 

@@ -46,8 +46,8 @@ import numpy as np
 from occupose.joints import JOINTS
 from occupose.evaluation.metrics import (
     ARM_PARTS, MIN_ARM_POINTS, Score, TableRow, arm_epsilons, frame_errors, joint_errors, markdown_table, match_tracks, score,
-    write_tracks_csv,
 )
+from occupose.io.joint_table import write_tracks_csv
 
 #: Methods compared when none are named.
 DEFAULT_METHODS: tuple[str, ...] = ("ours", "apf", "ps")

@@ -48,11 +48,8 @@ FAIL
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -71,9 +68,6 @@ ABSENT_COST_M = 0.5
 UNDER_BOUNDS_M: tuple[float, ...] = (0.10, 0.15, 0.20)
 #: Lower bound of the "over" column of Table I, metres (a frame counts when D_t > bound).
 OVER_BOUND_M = 0.20
-
-#: Header of ``tracks.csv`` (DESIGN.md).
-TRACKS_CSV_HEADER: tuple[str, ...] = ("frame", "track", "joint", "x", "y", "z", "visible")
 
 #: Column headings of Table I, plus the coverage of the frames with ground truth.
 TABLE_COLUMNS: tuple[str, ...] = (
@@ -828,152 +822,3 @@ def foreground_scores(pred_mask: Any, true_mask: Any) -> tuple[float, float, flo
         ratio(int(np.count_nonzero(true_mask))),
         ratio(int(np.count_nonzero(pred_mask | true_mask))),
     )
-
-
-# --------------------------------------------------------------------------- tracks.csv
-
-
-def read_tracks_csv(path: str | Path, num_frames: int) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """Read a tracker output ``tracks.csv`` (``frame,track,joint,x,y,z,visible``).
-
-    Parameters
-    ----------
-    path : the csv file (world metres, joints named as in `occupose.joints.JOINTS`).
-    num_frames : int, number of frames T of the recording; frames must be in [0, T).
-
-    Returns
-    -------
-    ``{track_id: (joints (T, 15, 3) float64 metres, visible (T, 15) bool)}``; joints
-    without a row are NaN and not visible.
-
-    Raises
-    ------
-    FileNotFoundError when the file is missing; ValueError, naming the file and line,
-    for a wrong header or column count, a non-numeric or non-finite value, an unknown
-    joint, a frame out of range, a ``visible`` other than 0/1 or a repeated row.
-    """
-    path = Path(path)
-    if isinstance(num_frames, bool) or not isinstance(num_frames, (int, np.integer)) or num_frames <= 0:
-        raise ValueError(f"num_frames must be a positive integer, got {num_frames!r}")
-    if not path.is_file():
-        raise FileNotFoundError(f"tracks file not found: {path}")
-    columns: dict[int, tuple[list[int], list[int], list[list[float]], list[bool]]] = {}
-    seen: set[tuple[int, int, int]] = set()
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as error:
-        raise ValueError(f"{path}: not a UTF-8 text file ({error.reason} at byte {error.start})") from None
-    reader = csv.reader(io.StringIO(text, newline=""))
-    header = next(reader, None)
-    if header is None or tuple(cell.strip() for cell in header) != TRACKS_CSV_HEADER:
-        raise ValueError(
-            f"{path}: expected header {','.join(TRACKS_CSV_HEADER)!r}, got "
-            f"{'an empty file' if header is None else repr(','.join(header))}"
-        )
-    for cells in reader:
-        if not cells:
-            continue
-        where = (path, reader.line_num)
-        if len(cells) != len(TRACKS_CSV_HEADER):
-            raise _csv_error(where, f"expected {len(TRACKS_CSV_HEADER)} columns, got {len(cells)}")
-        frame = _parse_int(cells[0], "frame", where)
-        track = _parse_int(cells[1], "track", where)
-        name = cells[2].strip()
-        joint = JOINT_INDEX.get(name)
-        if joint is None:
-            raise _csv_error(where, f"unknown joint {name!r} (valid: {', '.join(JOINTS)})")
-        position = [_parse_float(cells[3], "x", where), _parse_float(cells[4], "y", where),
-                    _parse_float(cells[5], "z", where)]
-        visible = cells[6].strip()
-        if visible not in ("0", "1"):
-            raise _csv_error(where, f"visible must be 0 or 1, got {visible!r}")
-        if not 0 <= frame < num_frames:
-            raise _csv_error(where, f"frame {frame} outside 0..{num_frames - 1}")
-        key = (frame, track, joint)
-        if key in seen:
-            raise _csv_error(where, f"repeated row for frame {frame}, track {track}, joint {name}")
-        seen.add(key)
-        if track not in columns:
-            columns[track] = ([], [], [], [])
-        frames, joints, positions, flags = columns[track]
-        frames.append(frame)
-        joints.append(joint)
-        positions.append(position)
-        flags.append(visible == "1")
-    tracks = {}
-    for track, (frames, joints, positions, flags) in columns.items():
-        points = np.full((num_frames, NUM_JOINTS, 3), np.nan)
-        points[frames, joints] = np.array(positions, dtype=np.float64)
-        visible_flags = np.zeros((num_frames, NUM_JOINTS), dtype=bool)
-        visible_flags[frames, joints] = flags
-        tracks[track] = (points, visible_flags)
-    return tracks
-
-
-def _csv_error(where: tuple[Path, int], message: str) -> ValueError:
-    return ValueError(f"{where[0]}, line {where[1]}: {message}")
-
-
-def _parse_int(text: str, name: str, where: tuple[Path, int]) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise _csv_error(where, f"{name} must be an integer, got {text!r}") from None
-
-
-def _parse_float(text: str, name: str, where: tuple[Path, int]) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise _csv_error(where, f"{name} must be a number, got {text!r}") from None
-    if not math.isfinite(value):
-        raise _csv_error(where, f"{name} must be finite, got {text!r}")
-    return value
-
-
-def write_tracks_csv(path: str | Path, tracks: Mapping[int, tuple[Any, Any]]) -> None:
-    """Write tracker output as ``tracks.csv`` (``frame,track,joint,x,y,z,visible``).
-
-    Parameters
-    ----------
-    path : the csv file to create (overwritten if present).
-    tracks : ``{track_id (int): (joints (T, 15, 3) float metres, visible (T, 15) bool)}``,
-        all with the same T. One row is written per frame, track and joint whose three
-        coordinates are finite (NaN joints are not reported), rows ordered by frame,
-        then track id, then canonical joint order; coordinates with 6 decimals
-        (micrometres).
-    """
-    checked = []
-    num_frames = None
-    for track_id, value in tracks.items():
-        if isinstance(track_id, bool) or not isinstance(track_id, (int, np.integer)):
-            raise ValueError(f"track ids must be integers, got {track_id!r}")
-        if not isinstance(value, tuple) or len(value) != 2:
-            raise ValueError(
-                f"track {track_id}: expected a (joints, visible) pair, got {type(value).__name__}"
-            )
-        joints = _float_array(value[0], f"track {track_id} joints", (None, NUM_JOINTS, 3))
-        visible = _bool_array(value[1], f"track {track_id} visible", joints.shape[:2])
-        if np.any(np.isinf(joints)):
-            raise ValueError(f"track {track_id} joints must be finite or NaN, got inf")
-        if num_frames is not None and joints.shape[0] != num_frames:
-            raise ValueError(
-                f"all tracks must have the same number of frames, got {num_frames} and "
-                f"{joints.shape[0]}"
-            )
-        num_frames = joints.shape[0]
-        checked.append((int(track_id), joints, visible))
-    checked.sort(key=lambda item: item[0])
-    with Path(path).open("w", newline="", encoding="utf-8") as handle:
-        handle.write(",".join(TRACKS_CSV_HEADER) + "\n")
-        for frame in range(num_frames or 0):
-            lines = [
-                f"{frame},{track_id},{JOINTS[joint]},{x:.6f},{y:.6f},{z:.6f},{int(flag)}\n"
-                for track_id, joints, visible in checked
-                for joint, ((x, y, z), flag, known) in enumerate(zip(
-                    joints[frame].tolist(), visible[frame].tolist(),
-                    np.all(np.isfinite(joints[frame]), axis=1).tolist(),
-                ))
-                if known
-            ]
-            handle.writelines(lines)
