@@ -30,7 +30,7 @@ import pytest
 from occupose.body import body_model, capsules_from_poses, joints_from_poses, pose_from_joints, standing_pose
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
-from occupose.evaluation.metrics import frame_errors, is_fail, joint_errors, table_row
+from occupose.evaluation.errors import frame_errors, is_fail, joint_errors, table_row
 from occupose.pose.problem import (
     FLOOR_COST,
     FLOOR_SLACK,

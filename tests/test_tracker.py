@@ -14,7 +14,7 @@ from occupose.camera import Camera, look_at, raw_depth_from_metres
 from occupose.cli import main
 from occupose.grid.pixels import Observation as GridObservation
 from occupose.joints import JOINT_INDEX, JOINTS
-from occupose.evaluation.metrics import frame_errors, joint_errors
+from occupose.evaluation.errors import frame_errors, joint_errors
 from occupose.pose.occlusion import hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.io.joint_table import read_tracks_csv
 from occupose.io.recording import Recording, RecordingWriter

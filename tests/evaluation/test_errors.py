@@ -1,4 +1,4 @@
-"""Tests of occupose.evaluation.metrics on hand-computed cases."""
+"""Tests of occupose.evaluation.errors on hand-computed cases."""
 
 import math
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from occupose.joints import JOINT_INDEX, NUM_JOINTS, UPPER_JOINTS
-from occupose.evaluation.metrics import (
+from occupose.evaluation.errors import (
     MIN_ARM_POINTS,
     MISSED_ERROR_M,
     TableRow,
