@@ -18,7 +18,7 @@ from dataclasses import replace
 import numpy as np
 
 from occupose.grid.pixels import persons_from_tracks
-from occupose.evaluation.errors import pixel_assignment_accuracy
+from occupose.evaluation.pixels import pixel_assignment_accuracy
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.tracker import Tracker, track_frames

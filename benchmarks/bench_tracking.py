@@ -4,7 +4,7 @@ The second paper's Fig. 5 (arm error versus computing time per frame, 3D model v
 part-based) as a table and a plot, for every filter of occupose.filters on two scenes:
 ``no_occlusion`` (front view, ``full`` model) and ``top_view_arms`` (ceiling camera,
 ``upper`` model), with three errors: the mean joint error, the arm joints' error (elbows
-and wrists) and the paper's own arm error epsilon (occupose.evaluation.errors.arm_epsilons: the
+and wrists) and the paper's own arm error epsilon (occupose.evaluation.pixels.arm_epsilons: the
 mean distance from the arm points to the arm bones; ``truth_eps_cm`` is the ground-truth
 skeleton's, the floor). As in issue 4's check:
 the ground-truth start pose, the person's own pixels from the renderer's person-id image
@@ -33,7 +33,8 @@ import numpy as np
 from occupose.body import body_model, pose_from_joints
 from occupose.joints import JOINT_INDEX
 from occupose.evaluation.evaluate import ARM_SAMPLE
-from occupose.evaluation.errors import ARM_PARTS, arm_epsilons, frame_errors, is_fail, joint_errors
+from occupose.evaluation.errors import frame_errors, is_fail, joint_errors
+from occupose.evaluation.pixels import ARM_PARTS, arm_epsilons
 from occupose.paths import mocap_dir
 from occupose.pose.problem import PoseEstimator, PoseProblem
 from occupose.synth.generate import UPPER_BODY_PARTS, person_observations

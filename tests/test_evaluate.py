@@ -15,7 +15,9 @@ from occupose.evaluation.evaluate import (
     report_markdown, results_table, table_rows, write_results_csv,
 )
 from occupose.joints import JOINTS
-from occupose.evaluation.errors import PersonScore, Score, TableRow, arm_epsilons
+from occupose.evaluation.errors import TableRow
+from occupose.evaluation.matching import PersonScore, Score
+from occupose.evaluation.pixels import arm_epsilons
 from occupose.io.joint_table import read_tracks_csv
 from occupose.io.recording import Recording
 

@@ -121,7 +121,8 @@ def score_cmd(recording, tracks) -> None:
 
 def score_text(rec, tracks_path: Path) -> str:
     """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person."""
-    from occupose.evaluation.errors import format_table, score
+    from occupose.evaluation.matching import score
+    from occupose.evaluation.report import format_table
     from occupose.io.joint_table import read_tracks_csv
 
     if not rec.has_groundtruth:
@@ -273,7 +274,7 @@ def demo_cmd(out, scenario, frames, method) -> None:
 def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
     from occupose.evaluation.evaluate import evaluate, table_rows
-    from occupose.evaluation.errors import markdown_table
+    from occupose.evaluation.report import markdown_table
 
     bars = []  # opened at the first report, once evaluate has checked its input and knows the total
 

@@ -1,6 +1,6 @@
-"""Accuracy of tracked skeletons against ground truth: Table I of the occupancy paper and more.
+"""Accuracy of tracked skeletons against ground truth: joint and frame errors, Table I of the occupancy paper.
 
-Every distance is in metres inside this module; tables report centimetres and percent.
+Every distance is in metres inside this module; a `TableRow` reports centimetres and percent.
 
 Definitions
 -----------
@@ -12,10 +12,10 @@ frame error ``D_t``
     and inside the optional mask, e.g. ground-truth-visible joints only).
 counted, estimated, missed and excluded frames
     A frame counts for a person when ground truth has the person and at least one of
-    their joints is visible to a camera (`score`; a person walking in, or fully behind
-    a cabinet, is not scored until something of them can be seen). A counted frame is
-    *estimated* when ``D_t`` is finite and *missed* when the tracker has no estimate of
-    the person. Other frames are excluded from everything.
+    their joints is visible to a camera (`occupose.evaluation.matching.score`; a person
+    walking in, or fully behind a cabinet, is not scored until something of them can be
+    seen). A counted frame is *estimated* when ``D_t`` is finite and *missed* when the
+    tracker has no estimate of the person. Other frames are excluded from everything.
 table row (Table I)
     ``mean`` and population ``std`` of ``D_t`` over the estimated frames (the paper's
     formula, ``1/T``); percentages over all counted frames of ``D_t <= 10, 15, 20 cm``
@@ -24,14 +24,6 @@ table row (Table I)
     ``>20`` add up to 100 %. A missed frame counts as an error above every bound (in
     ``>20``, in none of the others). ``coverage`` is the percentage of counted frames
     that are estimated.
-arm error ``epsilon`` (the second paper's)
-    Mean distance from a person's observed arm points (pixels of its upper arms,
-    forearms and hands: the renderer's part image) to the nearest arm bone
-    (shoulder-elbow, elbow-wrist) of a skeleton. The paper measures them "to the
-    estimated model state"; a skeleton is what every method reports, and the arms' bones
-    alone do not credit an arm point that the trunk would explain. The points lie on the
-    surface, a limb's radius from its bone and a hand's length beyond the wrist, so the
-    ground-truth skeleton has an epsilon too: the floor any estimate is read against.
 FAIL
     The rolling mean of ``D_t`` over a trailing window of ``window_s`` seconds
     (``round(window_s * fps)`` frames, the current frame included; windows reaching
@@ -50,83 +42,28 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
-from scipy.optimize import linear_sum_assignment
 
-from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS, PART_INDEX
+from occupose._validate import bool_array, float_array, nonnegative_float, positive_float
 
 #: Error a missed frame counts as in the FAIL rule's rolling mean, metres.
 MISSED_ERROR_M = 1.0
-#: Cost of a frame where a person has ground truth and a track has no estimate, when
-#: matching tracks to people (metres, as a mean joint distance).
-ABSENT_COST_M = 0.5
 
 #: Upper bounds of the "under" columns of Table I, metres (a frame counts when D_t <= bound).
 UNDER_BOUNDS_M: tuple[float, ...] = (0.10, 0.15, 0.20)
 #: Lower bound of the "over" column of Table I, metres (a frame counts when D_t > bound).
 OVER_BOUND_M = 0.20
 
-#: Column headings of Table I, plus the coverage of the frames with ground truth.
-TABLE_COLUMNS: tuple[str, ...] = (
-    "<10cm [%]", "<15cm [%]", "<20cm [%]", ">20cm [%]",
-    "Avg Err [cm]", "Std Dev [cm]", "Status", "Coverage [%]",
-)
-# TableRow attribute behind each column, and whether a higher value is better (None: not ranked).
-_COLUMN_FIELDS: tuple[tuple[str, bool | None], ...] = (
-    ("under10", True), ("under15", True), ("under20", True), ("over20", False),
-    ("mean_cm", False), ("std_cm", False), ("fail", None), ("coverage", True),
-)
-
-# Cost of an impossible pairing (no common frame) in the assignment problem; far above
-# any real mean distance in metres, so the solver pairs as many feasible pairs as it can.
-_NO_OVERLAP_COST = 1e6
-
 
 # --------------------------------------------------------------------------- checks
 
 
-def _positive_float(value: Any, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{what} must be a number, got {value!r}")
-    number = float(value)
-    if not math.isfinite(number) or number <= 0.0:
-        raise ValueError(f"{what} must be a positive finite number, got {value!r}")
-    return number
-
-
-def _nonnegative_float(value: Any, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{what} must be a number, got {value!r}")
-    number = float(value)
-    if not math.isfinite(number) or number < 0.0:
-        raise ValueError(f"{what} must be a finite number >= 0, got {value!r}")
-    return number
-
-
-def _float_array(value: Any, what: str, shape: tuple[int | None, ...]) -> np.ndarray:
-    """Return ``value`` as float64 with the given shape (None: any length)."""
-    array = np.asarray(value, dtype=np.float64)
-    if array.ndim != len(shape) or any(s is not None and s != n for s, n in zip(shape, array.shape)):
-        expected = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ")"
-        raise ValueError(f"{what} must have shape {expected}, got {array.shape}")
-    return array
-
-
-def _bool_array(value: Any, what: str, shape: tuple[int, ...]) -> np.ndarray:
-    array = np.asarray(value)
-    if array.dtype != np.bool_:
-        raise ValueError(f"{what} must be a boolean array, got dtype {array.dtype}")
-    if array.shape != shape:
-        raise ValueError(f"{what} must have shape {shape}, got {array.shape}")
-    return array
-
-
 def _frame_values(frame_errors: Any, missed: Any) -> np.ndarray:
     """Frame errors (T,) with missed frames set to +inf, after checking both inputs."""
-    values = _float_array(frame_errors, "frame_errors", (None,))
+    values = float_array(frame_errors, "frame_errors", (None,))
     if np.any(np.isinf(values)) or np.any(values < 0.0):
         raise ValueError(
             "frame_errors must be >= 0 metres, or NaN where a frame has no error "
@@ -134,7 +71,7 @@ def _frame_values(frame_errors: Any, missed: Any) -> np.ndarray:
         )
     if missed is None:
         return values
-    missed = _bool_array(missed, "missed", values.shape)
+    missed = bool_array(missed, "missed", values.shape)
     clash = missed & np.isfinite(values)
     if np.any(clash):
         raise ValueError(
@@ -193,10 +130,10 @@ def frame_errors(errors: Any, mask: Any = None) -> np.ndarray:
     (T,) float64, metres: mean over the joints where ``mask`` is true and the error is
     finite; NaN for a frame where no joint counts.
     """
-    errors = _float_array(errors, "errors", (None, None))
+    errors = float_array(errors, "errors", (None, None))
     counted = np.isfinite(errors)
     if mask is not None:
-        counted &= _bool_array(mask, "mask", errors.shape)
+        counted &= bool_array(mask, "mask", errors.shape)
     return _nanmean(np.where(counted, errors, np.nan), axis=1)
 
 
@@ -213,66 +150,13 @@ def per_joint_errors(errors: Any, joint_names: Sequence[str]) -> dict[str, float
     -------
     ``{name: mean error in cm}``; NaN for a joint without any finite error.
     """
-    errors = _float_array(errors, "errors", (None, None))
+    errors = float_array(errors, "errors", (None, None))
     if len(joint_names) != errors.shape[1]:
         raise ValueError(
             f"joint_names has {len(joint_names)} names but errors has {errors.shape[1]} joints"
         )
     means = _nanmean(errors, axis=0) * 100.0
     return {str(name): float(value) for name, value in zip(joint_names, means)}
-
-
-# --------------------------------------------------------------------------- arm error
-
-
-#: Body parts (occupose.joints.PARTS labels) whose points the arm error measures.
-ARM_PARTS: tuple[int, ...] = tuple(PART_INDEX[f"{side}_{part}"] for side in ("left", "right")
-                                   for part in ("upper_arm", "forearm", "hand"))
-#: Bones (joint index pairs) the arm points are measured to.
-ARM_BONES: tuple[tuple[int, int], ...] = tuple(
-    (JOINT_INDEX[f"{side}_{a}"], JOINT_INDEX[f"{side}_{b}"])
-    for side in ("left", "right") for a, b in (("shoulder", "elbow"), ("elbow", "wrist")))
-#: A frame with fewer arm points than this has no arm error (an arm seen by a few pixels
-#: at the edge of a hand says little).
-MIN_ARM_POINTS = 20
-
-
-def segment_distances(points: Any, starts: Any, ends: Any) -> np.ndarray:
-    """Distance from each point to the nearest of S segments.
-
-    points : (N, 3) float, metres; starts, ends : (S, 3) float, metres, S >= 1
-    Returns (N,) float64, metres.
-    """
-    points = _float_array(points, "points", (None, 3))
-    starts = _float_array(starts, "starts", (None, 3))
-    ends = _float_array(ends, "ends", (starts.shape[0], 3))
-    if starts.shape[0] == 0:
-        raise ValueError("segment_distances needs at least one segment")
-    axis = ends - starts                                          # (S, 3)
-    length2 = np.maximum(np.einsum("sk,sk->s", axis, axis), 1e-18)
-    offset = points[:, None, :] - starts[None]                    # (N, S, 3)
-    along = np.clip(np.einsum("nsk,sk->ns", offset, axis) / length2, 0.0, 1.0)
-    gap = offset - along[..., None] * axis[None]
-    return np.sqrt(np.einsum("nsk,nsk->ns", gap, gap).min(axis=1))
-
-
-def arm_epsilons(arm_points: Sequence[Any], joints: Any) -> np.ndarray:
-    """The second paper's arm error of every frame (module docstring).
-
-    arm_points : T arrays (N_t, 3), metres, world: the person's observed arm points
-    joints : (T, 15, 3) float, metres: the skeleton measured (NaN where not reported)
-    Returns (T,) float64, metres; NaN where a frame has fewer than MIN_ARM_POINTS points
-    or the skeleton misses an arm joint.
-    """
-    joints = _float_array(joints, "joints", (len(arm_points), NUM_JOINTS, 3))
-    starts = np.array([a for a, _ in ARM_BONES])
-    ends = np.array([b for _, b in ARM_BONES])
-    out = np.full(len(arm_points), np.nan)
-    for t, points in enumerate(arm_points):
-        skeleton = joints[t]
-        if len(points) >= MIN_ARM_POINTS and np.all(np.isfinite(skeleton[np.r_[starts, ends]])):
-            out[t] = float(segment_distances(points, skeleton[starts], skeleton[ends]).mean())
-    return out
 
 
 # --------------------------------------------------------------------------- FAIL rule
@@ -296,9 +180,9 @@ def rolling_mean(values: Any, fps: float, *, window_s: float = 2.0) -> np.ndarra
     -------
     (T,) float64: mean of the non-NaN values in each window; NaN where there are none.
     """
-    values = _float_array(values, "values", (None,))
-    fps = _positive_float(fps, "fps")
-    window_s = _positive_float(window_s, "window_s")
+    values = float_array(values, "values", (None,))
+    fps = positive_float(fps, "fps")
+    window_s = positive_float(window_s, "window_s")
     length = max(1, int(round(window_s * fps)))
     if values.size == 0:
         return values.copy()
@@ -341,8 +225,8 @@ def fail_curve(
     holds no counted frame.
     """
     values = _frame_values(frame_errors, missed)
-    fps = _positive_float(fps, "fps")
-    after_s = _nonnegative_float(after_s, "after_s")
+    fps = positive_float(fps, "fps")
+    after_s = nonnegative_float(after_s, "after_s")
     counted = np.flatnonzero(~np.isnan(values))
     start = counted[0] + int(math.ceil(after_s * fps - 1e-9)) if counted.size else values.size
     values[:start][np.isinf(values[:start])] = np.nan  # the tracker's time to find the person
@@ -365,7 +249,7 @@ def is_fail(
     Parameters as in `fail_curve`; ``threshold_m`` in metres, compared strictly (a
     rolling mean of exactly 25 cm does not FAIL).
     """
-    threshold_m = _positive_float(threshold_m, "threshold_m")
+    threshold_m = positive_float(threshold_m, "threshold_m")
     curve = fail_curve(frame_errors, fps, missed=missed, window_s=window_s, after_s=after_s)
     return bool(np.any(curve[~np.isnan(curve)] > threshold_m))
 
@@ -455,370 +339,3 @@ def table_row(frame_errors: Any, fps: float, *, missed: Any = None) -> TableRow:
 
 def _cell(value: float) -> str:
     return "n/a" if math.isnan(value) else f"{value:.2f}"
-
-
-def _cells(row: TableRow) -> list[str]:
-    return [
-        ("FAIL" if row.fail else "ok") if name == "fail" else _cell(getattr(row, name))
-        for name, _ in _COLUMN_FIELDS
-    ]
-
-
-def format_table(rows: Mapping[str, TableRow], *, name_header: str = "method") -> str:
-    """Plain-text table in the layout of Table I, columns aligned.
-
-    Parameters
-    ----------
-    rows : ``{name: TableRow}`` in display order.
-    name_header : heading of the first column.
-
-    Returns
-    -------
-    The table as lines joined by newlines (no trailing newline).
-    """
-    header = [name_header, *TABLE_COLUMNS]
-    body = [[str(name), *_cells(row)] for name, row in rows.items()]
-    widths = [max(len(line[i]) for line in [header, *body]) for i in range(len(header))]
-
-    def line(cells: list[str]) -> str:
-        first = cells[0].ljust(widths[0])
-        rest = (cell.rjust(width) for cell, width in zip(cells[1:], widths[1:]))
-        return "  ".join([first, *rest]).rstrip()
-
-    return "\n".join([line(header), *(line(cells) for cells in body)])
-
-
-def markdown_table(
-    groups: Mapping[str, Mapping[str, TableRow]],
-    *,
-    group_header: str = "sequence",
-    name_header: str = "method",
-) -> str:
-    """Markdown table in the layout of Table I, the best value of each group in bold.
-
-    Parameters
-    ----------
-    groups : ``{group: {name: TableRow}}``, e.g. sequences, each holding the methods
-        compared on it. Within a group, the best value of each column is bold (every
-        row that ties on the printed value): lowest for ``>20cm``, ``Avg Err`` and
-        ``Std Dev``, highest for ``<10/15/20cm`` and ``Coverage``. Status is not ranked.
-    group_header, name_header : headings of the first two columns.
-
-    Returns
-    -------
-    The markdown table (no trailing newline).
-    """
-    header = [group_header, name_header, *TABLE_COLUMNS]
-    rule = ["---"] * 2 + ["---:"] * len(TABLE_COLUMNS)
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(rule) + "|"]
-    for group, rows in groups.items():
-        cells = {name: _cells(row) for name, row in rows.items()}
-        for column, (field, higher_better) in enumerate(_COLUMN_FIELDS):
-            if higher_better is None:
-                continue
-            printed = {
-                name: round(getattr(row, field), 2)
-                for name, row in rows.items()
-                if not math.isnan(getattr(row, field))
-            }
-            if not printed:
-                continue
-            best = max(printed.values()) if higher_better else min(printed.values())
-            for name, value in printed.items():
-                if value == best:
-                    cells[name][column] = f"**{cells[name][column]}**"
-        for index, (name, row_cells) in enumerate(cells.items()):
-            first = str(group) if index == 0 else ""
-            lines.append("| " + " | ".join([first, str(name), *row_cells]) + " |")
-    return "\n".join(lines)
-
-
-# --------------------------------------------------------------------------- tracks vs people
-
-
-def _check_people(gt: Any, what: str = "gt") -> np.ndarray:
-    gt = np.asarray(gt, dtype=np.float64)
-    if gt.ndim != 4 or gt.shape[-1] != 3:
-        raise ValueError(f"{what} must have shape (T, P, J, 3), got {gt.shape}")
-    return gt
-
-
-def _check_tracks(
-    tracks: Mapping[Any, Any], num_frames: int, num_joints: int
-) -> dict[Any, np.ndarray]:
-    if not isinstance(tracks, Mapping):
-        raise ValueError(
-            f"tracks must be a mapping track id -> (T, J, 3) array, got {type(tracks).__name__}"
-        )
-    checked = {}
-    for track_id, joints in tracks.items():
-        joints = np.asarray(joints, dtype=np.float64)
-        if joints.shape != (num_frames, num_joints, 3):
-            raise ValueError(
-                f"track {track_id!r} must have shape ({num_frames}, {num_joints}, 3) like the "
-                f"ground truth, got {joints.shape}"
-            )
-        checked[track_id] = joints
-    return checked
-
-
-def _pair_distances(gt: np.ndarray, tracks: dict[Any, np.ndarray]) -> np.ndarray:
-    """Mean joint distance of every person and track at every frame.
-
-    gt : (T, P, J, 3); tracks : K arrays (T, J, 3). Returns (T, P, K) metres, NaN where
-    the pair has no joint finite in both.
-    """
-    num_frames, num_people = gt.shape[:2]
-    if not tracks:
-        return np.full((num_frames, num_people, 0), np.nan)
-    stacked = np.stack(list(tracks.values()), axis=1)  # (T, K, J, 3)
-    distances = np.linalg.norm(gt[:, :, None] - stacked[:, None], axis=-1)  # (T, P, K, J)
-    return _nanmean(distances, axis=3)
-
-
-def _assign(cost: np.ndarray) -> list[tuple[int, int]]:
-    """Optimal pairs (row, column) of a cost matrix with NaN for impossible pairs."""
-    if cost.size == 0:
-        return []
-    feasible = np.isfinite(cost)
-    rows, cols = linear_sum_assignment(np.where(feasible, cost, _NO_OVERLAP_COST))
-    return [(int(r), int(c)) for r, c in zip(rows, cols) if feasible[r, c]]
-
-
-def match_tracks(gt: Any, tracks: Mapping[Any, Any]) -> dict[Any, int]:
-    """Assign each track to at most one ground-truth person for the whole sequence.
-
-    Parameters
-    ----------
-    gt : (T, P, J, 3) float, metres
-        Ground-truth joints of P people; NaN where a person (or joint) is absent.
-    tracks : ``{track_id: (T, J, 3) float, metres}``, NaN where absent.
-
-    Returns
-    -------
-    ``{track_id: person index}``. The assignment minimises the summed cost
-    (`scipy.optimize.linear_sum_assignment`); the cost of a pair is the mean over the
-    person's frames of the mean joint distance where both have a joint in common, and
-    ``ABSENT_COST_M`` where the person has ground truth and the track has none (so a
-    track present in one frame does not beat one that follows the person throughout).
-    A pair with no frame in common cannot be matched; a track left over (more tracks
-    than people, or no overlap) is unmatched and absent from the result.
-    """
-    gt = _check_people(gt)
-    tracks = _check_tracks(tracks, gt.shape[0], gt.shape[2])
-    distances = _pair_distances(gt, tracks)  # (T, P, K)
-    person_frames = np.any(np.all(np.isfinite(gt), axis=3), axis=2)  # (T, P)
-    track_frames = np.stack([np.any(np.all(np.isfinite(t), axis=2), axis=1) for t in tracks.values()], axis=1) \
-        if tracks else np.zeros((gt.shape[0], 0), bool)  # (T, K)
-    absent = person_frames[:, :, None] & ~track_frames[:, None, :]
-    overlap = np.isfinite(distances)
-    total = np.where(overlap, distances, 0.0).sum(axis=0) + ABSENT_COST_M * absent.sum(axis=0)
-    frames = (overlap | absent).sum(axis=0)
-    cost = np.where(overlap.any(axis=0), total / np.maximum(frames, 1), np.nan)  # (P, K)
-    ids = list(tracks)
-    return {ids[k]: p for p, k in _assign(cost)}
-
-
-def identity_switches(gt: Any, tracks: Mapping[Any, Any], *, gate_m: float = 0.5) -> np.ndarray:
-    """Number of identity switches of each ground-truth person.
-
-    Each frame, people and tracks are matched optimally on the mean joint distance
-    (joints finite in both), keeping only pairs within ``gate_m``. A switch is counted
-    when the track covering a person differs from the last track that covered it
-    (frames where nothing covers the person are skipped, as in CLEAR MOT).
-
-    Parameters
-    ----------
-    gt : (T, P, J, 3) float, metres; NaN where absent.
-    tracks : ``{track_id: (T, J, 3) float, metres}``; NaN where absent.
-    gate_m : float
-        Largest mean joint distance of a frame-wise match, metres.
-
-    Returns
-    -------
-    (P,) int64 switch counts.
-    """
-    gt = _check_people(gt)
-    tracks = _check_tracks(tracks, gt.shape[0], gt.shape[2])
-    gate_m = _positive_float(gate_m, "gate_m")
-    distances = _pair_distances(gt, tracks)  # (T, P, K)
-    switches = np.zeros(gt.shape[1], dtype=np.int64)
-    last = np.full(gt.shape[1], -1)
-    for cost in distances:
-        for person, track in _assign(np.where(cost <= gate_m, cost, np.nan)):
-            if last[person] >= 0 and last[person] != track:
-                switches[person] += 1
-            last[person] = track
-    return switches
-
-
-@dataclass(frozen=True)
-class PersonScore:
-    """Scores of one ground-truth person.
-
-    Attributes
-    ----------
-    track : track id matched to the person for the whole sequence, or None.
-    all_joints : TableRow over all evaluated joints.
-    visible_joints : TableRow over the ground-truth-visible evaluated joints.
-    per_joint_cm : ``{joint name: mean error, cm}`` over the evaluated joints.
-    identity_switches : int, frame-wise (`identity_switches`).
-    """
-
-    track: Any
-    all_joints: TableRow
-    visible_joints: TableRow
-    per_joint_cm: dict[str, float]
-    identity_switches: int
-
-
-@dataclass(frozen=True)
-class Score:
-    """Scores of one sequence: one `PersonScore` per ground-truth person.
-
-    Attributes
-    ----------
-    persons : tuple of PersonScore, in ground-truth person order.
-    unmatched_tracks : track ids matched to no person.
-    identity_switches : total over the people.
-    """
-
-    persons: tuple[PersonScore, ...]
-    unmatched_tracks: tuple[Any, ...]
-    identity_switches: int
-
-
-def score(
-    gt_joints: Any,
-    gt_visible: Any,
-    tracks: Mapping[Any, Any],
-    fps: float,
-    *,
-    gate_m: float = 0.5,
-) -> Score:
-    """Score tracked skeletons against ground truth, person by person.
-
-    Tracks are matched to people with `match_tracks`. For each person, the evaluated
-    joints are those the matched track reports in at least one frame (the upper-body
-    model reports 9 of the 15); the other joints are left out of both sides. A frame
-    counts when ground truth has at least one evaluated joint and at least one of the
-    person's joints is visible (for the visible-only row: at least one visible evaluated
-    joint), and is missed when the track has no
-    evaluated joint in it (a frame where both have joints but none in common has no
-    error and is left out). A person without a track is missed in every counted frame
-    (evaluated joints: all 15).
-
-    Parameters
-    ----------
-    gt_joints : (T, P, 15, 3) float, metres; NaN where a person is absent.
-    gt_visible : (T, P, 15) bool, ground-truth visibility of each joint.
-    tracks : ``{track_id: (T, 15, 3) float, metres}``; NaN where not reported.
-    fps : float, frames per second.
-    gate_m : float, distance gate of the frame-wise matching for identity switches, metres.
-
-    Returns
-    -------
-    Score.
-    """
-    gt_joints = _check_people(gt_joints, "gt_joints")
-    num_frames, num_people, num_joints = gt_joints.shape[:3]
-    if num_joints != NUM_JOINTS:
-        raise ValueError(f"gt_joints must hold the {NUM_JOINTS} canonical joints, got {num_joints}")
-    gt_visible = _bool_array(gt_visible, "gt_visible", gt_joints.shape[:3])
-    tracks = _check_tracks(tracks, num_frames, num_joints)
-    fps = _positive_float(fps, "fps")
-    matches = match_tracks(gt_joints, tracks)
-    track_of = {person: track_id for track_id, person in matches.items()}
-    switches = identity_switches(gt_joints, tracks, gate_m=gate_m)
-    persons = []
-    for person in range(num_people):
-        track_id = track_of.get(person)
-        if track_id is None:
-            est = np.full((num_frames, num_joints, 3), np.nan)
-            evaluated = np.ones(num_joints, dtype=bool)
-        else:
-            est = tracks[track_id]
-            evaluated = np.any(np.all(np.isfinite(est), axis=2), axis=0)
-        gt = gt_joints[:, person, evaluated]
-        est = est[:, evaluated]
-        visible = gt_visible[:, person, evaluated]
-        in_sight = np.any(gt_visible[:, person], axis=1)[:, None]
-        gt_known = np.all(np.isfinite(gt), axis=2) & in_sight
-        has_estimate = np.any(np.all(np.isfinite(est), axis=2), axis=1)
-        errors = joint_errors(gt, est)
-        rows = []
-        for counted in (gt_known, gt_known & visible):
-            missed = np.any(counted, axis=1) & ~has_estimate
-            rows.append(table_row(frame_errors(errors, counted), fps, missed=missed))
-        names = [name for name, keep in zip(JOINTS, evaluated) if keep]
-        persons.append(PersonScore(
-            track=track_id, all_joints=rows[0], visible_joints=rows[1],
-            per_joint_cm=per_joint_errors(errors, names),
-            identity_switches=int(switches[person]),
-        ))
-    unmatched = tuple(track_id for track_id in tracks if track_id not in matches)
-    return Score(
-        persons=tuple(persons), unmatched_tracks=unmatched, identity_switches=int(switches.sum())
-    )
-
-
-# --------------------------------------------------------------------------- pixels
-
-
-def pixel_assignment_accuracy(assigned: Any, truth: Any, foreground: Any) -> float:
-    """Share of foreground pixels assigned to the right person.
-
-    Parameters
-    ----------
-    assigned : (H, W) int, person label given to each pixel by the tracker (labels
-        already mapped to ground-truth person ids).
-    truth : (H, W) int, true person label of each pixel.
-    foreground : (H, W) bool, pixels that are scored (e.g. the true foreground).
-
-    Returns
-    -------
-    Fraction in [0, 1]; NaN when ``foreground`` is empty.
-    """
-    assigned = np.asarray(assigned)
-    truth = np.asarray(truth)
-    if assigned.ndim != 2 or assigned.shape != truth.shape:
-        raise ValueError(
-            f"assigned and truth must be (H, W) label images of the same shape, got "
-            f"{assigned.shape} and {truth.shape}"
-        )
-    for name, image in (("assigned", assigned), ("truth", truth)):
-        if not np.issubdtype(image.dtype, np.integer):
-            raise ValueError(f"{name} must hold integer labels, got dtype {image.dtype}")
-    foreground = _bool_array(foreground, "foreground", truth.shape)
-    total = int(np.count_nonzero(foreground))
-    if total == 0:
-        return math.nan
-    return float(np.count_nonzero(assigned[foreground] == truth[foreground]) / total)
-
-
-def foreground_scores(pred_mask: Any, true_mask: Any) -> tuple[float, float, float]:
-    """Precision, recall and intersection over union of a foreground mask.
-
-    Parameters
-    ----------
-    pred_mask, true_mask : (H, W) bool (any matching shape), predicted and true foreground.
-
-    Returns
-    -------
-    ``(precision, recall, iou)`` as fractions in [0, 1]; each is NaN when its
-    denominator (predicted, true, union pixels) is empty.
-    """
-    pred_mask = np.asarray(pred_mask)
-    if pred_mask.dtype != np.bool_:
-        raise ValueError(f"pred_mask must be a boolean array, got dtype {pred_mask.dtype}")
-    true_mask = _bool_array(true_mask, "true_mask", pred_mask.shape)
-    hits = int(np.count_nonzero(pred_mask & true_mask))
-
-    def ratio(denominator: int) -> float:
-        return hits / denominator if denominator else math.nan
-
-    return (
-        ratio(int(np.count_nonzero(pred_mask))),
-        ratio(int(np.count_nonzero(true_mask))),
-        ratio(int(np.count_nonzero(pred_mask | true_mask))),
-    )

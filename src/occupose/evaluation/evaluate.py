@@ -44,9 +44,10 @@ from pathlib import Path
 import numpy as np
 
 from occupose.joints import JOINTS
-from occupose.evaluation.errors import (
-    ARM_PARTS, MIN_ARM_POINTS, Score, TableRow, arm_epsilons, frame_errors, joint_errors, markdown_table, match_tracks, score,
-)
+from occupose.evaluation.errors import TableRow, frame_errors, joint_errors
+from occupose.evaluation.matching import Score, match_tracks, score
+from occupose.evaluation.pixels import ARM_PARTS, MIN_ARM_POINTS, arm_epsilons
+from occupose.evaluation.report import markdown_table
 from occupose.io.joint_table import write_tracks_csv
 
 #: Methods compared when none are named.
@@ -59,7 +60,7 @@ PARTLY_HIDDEN = 0.25
 MOSTLY_HIDDEN = 0.75
 #: FAIL threshold drawn in the error plots, cm (errors.is_fail).
 FAIL_THRESHOLD_CM = 25.0
-#: Arm points per person and frame that the arm error (errors.arm_epsilons) measures at
+#: Arm points per person and frame that the arm error (pixels.arm_epsilons) measures at
 #: most, an even subsample of those seen.
 ARM_SAMPLE = 400
 #: Name of the file beside a rendered recording that records how it was rendered.
@@ -75,14 +76,14 @@ Progress = Callable[[int, int], None]
 class RunResult:
     """One method on one scenario with one seed.
 
-    score : the Table I scores of every ground-truth person (occupose.evaluation.errors.Score)
+    score : the Table I scores of every ground-truth person (occupose.evaluation.matching.Score)
     person_ids : ground-truth person ids, in the order of ``score.persons``
     frame_errors : (T, P) float64, metres: D_t of each person over the joints the matched
         track reports (NaN where the person is not counted or has no estimate)
     fps : frames per second of tracking, start-up excluded
     seconds : seconds per stage, ``total`` and ``startup`` (TrackingResult.seconds)
     arm_epsilon, truth_arm_epsilon : (T, P) float64, metres, or None for a recording
-        without part labels: the second paper's arm error (errors.arm_epsilons) of each
+        without part labels: the second paper's arm error (pixels.arm_epsilons) of each
         person's matched track (NaN without an estimate) and of its ground truth
     """
 
@@ -172,7 +173,7 @@ def render_recording(scenario: str, out: Path, frames: int | None, procedural: b
 
 def arm_points(rec, person_ids: Sequence[int], max_points: int = ARM_SAMPLE) -> list[list[np.ndarray]]:
     """[person][frame] (N, 3) float64, world metres: the pixels of each person's arms
-    (errors.ARM_PARTS in the recording's part labels) that every camera measured,
+    (pixels.ARM_PARTS in the recording's part labels) that every camera measured,
     back-projected; at most ``max_points`` per frame, an even subsample. The recording
     must have person and part labels (Recording.has_labels)."""
     from occupose.camera import points_from_depth
@@ -194,7 +195,7 @@ def arm_points(rec, person_ids: Sequence[int], max_points: int = ARM_SAMPLE) -> 
 
 def _tracked_arm_epsilons(gt_joints: np.ndarray, arms: list[list[np.ndarray]],
                           tracks: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """(T, P) arm error (errors.arm_epsilons) of each person's matched track (NaN
+    """(T, P) arm error (pixels.arm_epsilons) of each person's matched track (NaN
     without one) and of its ground-truth skeleton, metres."""
     tracked = np.full(gt_joints.shape[:2], np.nan)
     for track_id, person in match_tracks(gt_joints, tracks).items():
@@ -204,7 +205,7 @@ def _tracked_arm_epsilons(gt_joints: np.ndarray, arms: list[list[np.ndarray]],
 
 
 def _tracked_frame_errors(gt_joints: np.ndarray, gt_visible: np.ndarray, tracks: dict[int, np.ndarray]) -> np.ndarray:
-    """(T, P) D_t of each person against its matched track, as errors.score counts it
+    """(T, P) D_t of each person against its matched track, as matching.score counts it
     (joints the track reports, frames where some joint of the person is visible)."""
     num_frames, num_people = gt_joints.shape[:2]
     out = np.full((num_frames, num_people), np.nan)
@@ -437,7 +438,7 @@ def results_table(runs: Sequence[RunResult]) -> list[dict[str, object]]:
 
 
 def _arm_errors_cm(run: RunResult, person: int) -> tuple[float, float]:
-    """Mean arm error (errors.arm_epsilons) over the frames that have one, cm, of the
+    """Mean arm error (pixels.arm_epsilons) over the frames that have one, cm, of the
     person's track and of its ground truth; NaN without one (or without part labels)."""
     if run.arm_epsilon is None:
         return math.nan, math.nan
@@ -524,7 +525,7 @@ def _arm_section(runs: Sequence[RunResult], methods: list[str]) -> list[str]:
             "Mean over the frames with at least "
             f"{MIN_ARM_POINTS} arm points seen and an estimate, and over the runs, of the mean distance from "
             "the person's arm points (upper arms, forearms, hands in the part labels; every camera) to the "
-            "nearest arm bone of the skeleton (occupose.evaluation.errors). Lowest per sequence in bold. The points lie "
+            "nearest arm bone of the skeleton (occupose.evaluation.pixels). Lowest per sequence in bold. The points lie "
             "on the surface, so the ground truth's skeleton has an epsilon too (last column): what a perfect "
             "skeleton scores.", "",
             _markdown(["sequence", *methods, "ground truth"], rows), ""]
