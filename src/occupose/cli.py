@@ -122,7 +122,7 @@ def score_cmd(recording, tracks) -> None:
 def score_text(rec, tracks_path: Path) -> str:
     """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person."""
     from occupose.evaluation.matching import score
-    from occupose.evaluation.report import format_table
+    from occupose.evaluation.report import TABLE_COLUMNS, markdown_table, table_i_cells
     from occupose.io.joint_table import read_tracks_csv
 
     if not rec.has_groundtruth:
@@ -130,12 +130,12 @@ def score_text(rec, tracks_path: Path) -> str:
     gt = rec.groundtruth()
     tracks = read_tracks_csv(tracks_path, rec.num_frames)
     result = score(gt.joints, gt.visible, {k: v[0] for k, v in tracks.items()}, rec.fps)
-    rows = {}
+    rows = []
     for pid, person in zip(gt.person_ids, result.persons):
         track = "none" if person.track is None else f"track {person.track}"
-        rows[f"person {pid} ({track}) all joints"] = person.all_joints
-        rows[f"person {pid} ({track}) visible joints"] = person.visible_joints
-    lines = [format_table(rows, name_header="person")]
+        rows.append([f"person {pid} ({track}) all joints", *table_i_cells(person.all_joints)])
+        rows.append([f"person {pid} ({track}) visible joints", *table_i_cells(person.visible_joints)])
+    lines = [markdown_table(["person", *TABLE_COLUMNS], rows, text_columns=1)]
     lines.append(f"identity switches: {result.identity_switches}; unmatched tracks: "
                  f"{list(result.unmatched_tracks) or 'none'}")
     return "\n".join(lines)
@@ -274,7 +274,7 @@ def demo_cmd(out, scenario, frames, method) -> None:
 def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
     from occupose.evaluation.evaluate import evaluate, table_rows
-    from occupose.evaluation.report import markdown_table
+    from occupose.evaluation.report import table_i_markdown
 
     bars = []  # opened at the first report, once evaluate has checked its input and knows the total
 
@@ -291,5 +291,5 @@ def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> Non
     finally:
         for bar in bars:
             bar.close()
-    click.echo(markdown_table(table_rows(result.runs)))
+    click.echo(table_i_markdown(table_rows(result.runs)))
     click.echo(f"report: {result.report}\nresults: {result.results}\nplots: {len(result.plots)} in {out}")

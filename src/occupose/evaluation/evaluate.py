@@ -47,7 +47,7 @@ from occupose.joints import JOINTS
 from occupose.evaluation.errors import TableRow, frame_errors, joint_errors
 from occupose.evaluation.matching import Score, match_tracks, score
 from occupose.evaluation.pixels import ARM_PARTS, MIN_ARM_POINTS, arm_epsilons
-from occupose.evaluation.report import markdown_table
+from occupose.evaluation.report import markdown_table, number_cell, table_i_markdown
 from occupose.io.joint_table import write_tracks_csv
 
 #: Methods compared when none are named.
@@ -496,15 +496,6 @@ def speed_table(runs: Sequence[RunResult]) -> dict[str, dict[str, float]]:
     return out
 
 
-def _number(value: float, digits: int = 2) -> str:
-    return "n/a" if math.isnan(value) else f"{value:.{digits}f}"
-
-
-def _markdown(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(["---"] + ["---:"] * (len(header) - 1)) + "|"]
-    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])
-
-
 def _arm_section(runs: Sequence[RunResult], methods: list[str]) -> list[str]:
     """The report's lines on the second paper's arm error (none without part labels)."""
     rows = []
@@ -517,8 +508,8 @@ def _arm_section(runs: Sequence[RunResult], methods: list[str]) -> list[str]:
         finite = [v for v in tracked.values() if not math.isnan(v)]
         best = min(finite) if len(finite) > 1 else math.nan
         truth = next(t for pairs in means.values() for _, t in pairs)
-        rows.append([label, *(f"**{_number(tracked[m])}**" if round(tracked.get(m, math.nan), 2) == round(best, 2)
-                              else _number(tracked.get(m, math.nan)) for m in methods), _number(truth)])
+        rows.append([label, *(f"**{number_cell(tracked[m])}**" if round(tracked.get(m, math.nan), 2) == round(best, 2)
+                              else number_cell(tracked.get(m, math.nan)) for m in methods), number_cell(truth)])
     if not rows:
         return []
     return ["## Arm error: the second paper's epsilon [cm]", "",
@@ -528,7 +519,7 @@ def _arm_section(runs: Sequence[RunResult], methods: list[str]) -> list[str]:
             "nearest arm bone of the skeleton (occupose.evaluation.pixels). Lowest per sequence in bold. The points lie "
             "on the surface, so the ground truth's skeleton has an epsilon too (last column): what a perfect "
             "skeleton scores.", "",
-            _markdown(["sequence", *methods, "ground truth"], rows), ""]
+            markdown_table(["sequence", *methods, "ground truth"], rows, text_columns=1), ""]
 
 
 def report_markdown(runs: Sequence[RunResult], plots: Sequence[Path] = (), root: Path | None = None, *,
@@ -546,8 +537,8 @@ def report_markdown(runs: Sequence[RunResult], plots: Sequence[Path] = (), root:
     lines += ["", "Each value is the mean over the runs (runs without any estimate are left out of "
               "the mean and std); Status is FAIL when any run FAILs (the 2-second rolling mean of D_t "
               "exceeds 25 cm after the first second; occupose.evaluation.errors). Best value of each column per "
-              "sequence in **bold**.", "", "## Table I: all joints", "", markdown_table(table_rows(runs)), "",
-              "## Table I: ground-truth-visible joints only", "", markdown_table(table_rows(runs, visible=True)), ""]
+              "sequence in **bold**.", "", "## Table I: all joints", "", table_i_markdown(table_rows(runs)), "",
+              "## Table I: ground-truth-visible joints only", "", table_i_markdown(table_rows(runs, visible=True)), ""]
     fails = []
     for label, by_method in _groups(runs).items():
         for method, items in by_method.items():
@@ -564,32 +555,32 @@ def report_markdown(runs: Sequence[RunResult], plots: Sequence[Path] = (), root:
                               for r in runs if r.scenario == scenario)
             lines.append(f"- {scenario} ({found})")
         lines.append("")
-    switches = [[label, method, _number(float(np.mean([r.score.persons[i].identity_switches for r, i in items]))),
-                 _number(float(np.mean([len(r.score.unmatched_tracks) for r, i in items])))]
+    switches = [[label, method, number_cell(float(np.mean([r.score.persons[i].identity_switches for r, i in items]))),
+                 number_cell(float(np.mean([len(r.score.unmatched_tracks) for r, i in items])))]
                 for label, by_method in _groups(runs).items() for method, items in by_method.items()]
     lines += ["## Identities", "", "Mean over the runs of the person's identity switches and of the "
               "tracks matched to no person.", "",
-              _markdown(["sequence", "method", "identity switches", "unmatched tracks"], switches), ""]
+              markdown_table(["sequence", "method", "identity switches", "unmatched tracks"], switches, text_columns=1), ""]
     lines += _arm_section(runs, methods)
     joints = per_joint_table(runs)
     joint_rows = []
     for joint, values in joints.items():
         finite = [v for v in values.values() if not math.isnan(v)]
         best = min(finite) if finite else math.nan
-        joint_rows.append([joint, *(f"**{_number(v)}**" if len(finite) > 1 and round(v, 2) == round(best, 2)
-                                    else _number(v) for v in values.values())])
+        joint_rows.append([joint, *(f"**{number_cell(v)}**" if len(finite) > 1 and round(v, 2) == round(best, 2)
+                                    else number_cell(v) for v in values.values())])
     lines += ["## Per-joint error [cm]", "", "Mean over scenarios, runs and people; lowest per joint in bold (when several methods report it); "
               "n/a: the method's model does not report the joint.", "",
-              _markdown(["joint", *methods], joint_rows), ""]
+              markdown_table(["joint", *methods], joint_rows, text_columns=1), ""]
     speeds = speed_table(runs)
     stage_columns = list(dict.fromkeys(k for v in speeds.values() for k in v if k.endswith(" ms")))
-    speed_rows = [[m, _number(v["fps"], 1), _number(v["ms"], 1), *(_number(v.get(k, math.nan), 1) for k in stage_columns)]
+    speed_rows = [[m, number_cell(v["fps"], 1), number_cell(v["ms"], 1), *(number_cell(v.get(k, math.nan), 1) for k in stage_columns)]
                   for m, v in speeds.items()]
     timing = ("in parallel, one run per worker and core, one numba thread per worker" if (jobs or 1) > 1
               else "one run at a time with numba's default threads")
     lines += ["## Speed", "", f"Mean over all runs, timed {timing} (`occupose track` alone can be faster); "
               "the first frame (start-up, compilation) excluded; per-stage times include it.", "",
-              _markdown(["method", "frames/s", "ms/frame", *stage_columns], speed_rows), ""]
+              markdown_table(["method", "frames/s", "ms/frame", *stage_columns], speed_rows, text_columns=1), ""]
     if plots:
         lines += ["## Plots", ""]
         for plot in plots:

@@ -1,9 +1,14 @@
-"""Tables of the evaluation: Table I as plain text and as markdown."""
+"""Tables of the evaluation, all written by one markdown table writer (`markdown_table`).
+
+Table I of the occupancy paper is `table_i_markdown`: one line per sequence and method, the
+columns `TABLE_COLUMNS` (a `TableRow`'s cells, `table_i_cells`), the best value of each
+column per sequence in bold. Numbers are printed with `number_cell` ("n/a" for NaN).
+"""
 
 from __future__ import annotations
 
 import math
-from typing import Mapping
+from typing import Iterable, Mapping, Sequence
 
 from occupose.evaluation.errors import TableRow
 
@@ -19,43 +24,48 @@ _COLUMN_FIELDS: tuple[tuple[str, bool | None], ...] = (
 )
 
 
-
-def _cell(value: float) -> str:
-    return "n/a" if math.isnan(value) else f"{value:.2f}"
+# --------------------------------------------------------------------------- the table writer
 
 
-def _cells(row: TableRow) -> list[str]:
+def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]], *, text_columns: int | None = None) -> str:
+    """A markdown table: the header line, the rule, one line per row (no trailing newline).
+
+    Parameters
+    ----------
+    header : the column headings.
+    rows : the cells of each row, as strings, one per heading.
+    text_columns : the first ``text_columns`` columns hold text (rule ``---``), the others
+        numbers, right-aligned (rule ``---:``); None: no alignment (every rule ``---``).
+    """
+    header = [str(cell) for cell in header]
+    rule = ["---"] * len(header) if text_columns is None else \
+        ["---"] * text_columns + ["---:"] * (len(header) - text_columns)
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(rule) + "|"]
+    for row in rows:
+        if len(row) != len(header):
+            raise ValueError(f"a row of {len(header)} columns {header} has {len(row)} cells: {list(row)}")
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def number_cell(value: float, digits: int = 2) -> str:
+    """``value`` with ``digits`` decimals, or "n/a" for NaN."""
+    return "n/a" if math.isnan(value) else f"{value:.{digits}f}"
+
+
+# --------------------------------------------------------------------------- Table I
+
+
+def table_i_cells(row: TableRow) -> list[str]:
+    """The cells of ``row`` under `TABLE_COLUMNS`: percentages and centimetres with 2
+    decimals, "n/a" where NaN, the status "ok" or "FAIL"."""
     return [
-        ("FAIL" if row.fail else "ok") if name == "fail" else _cell(getattr(row, name))
+        ("FAIL" if row.fail else "ok") if name == "fail" else number_cell(getattr(row, name))
         for name, _ in _COLUMN_FIELDS
     ]
 
 
-def format_table(rows: Mapping[str, TableRow], *, name_header: str = "method") -> str:
-    """Plain-text table in the layout of Table I, columns aligned.
-
-    Parameters
-    ----------
-    rows : ``{name: TableRow}`` in display order.
-    name_header : heading of the first column.
-
-    Returns
-    -------
-    The table as lines joined by newlines (no trailing newline).
-    """
-    header = [name_header, *TABLE_COLUMNS]
-    body = [[str(name), *_cells(row)] for name, row in rows.items()]
-    widths = [max(len(line[i]) for line in [header, *body]) for i in range(len(header))]
-
-    def line(cells: list[str]) -> str:
-        first = cells[0].ljust(widths[0])
-        rest = (cell.rjust(width) for cell, width in zip(cells[1:], widths[1:]))
-        return "  ".join([first, *rest]).rstrip()
-
-    return "\n".join([line(header), *(line(cells) for cells in body)])
-
-
-def markdown_table(
+def table_i_markdown(
     groups: Mapping[str, Mapping[str, TableRow]],
     *,
     group_header: str = "sequence",
@@ -73,13 +83,11 @@ def markdown_table(
 
     Returns
     -------
-    The markdown table (no trailing newline).
+    The markdown table (no trailing newline); a group's name only on its first line.
     """
-    header = [group_header, name_header, *TABLE_COLUMNS]
-    rule = ["---"] * 2 + ["---:"] * len(TABLE_COLUMNS)
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(rule) + "|"]
+    lines = []
     for group, rows in groups.items():
-        cells = {name: _cells(row) for name, row in rows.items()}
+        cells = {name: table_i_cells(row) for name, row in rows.items()}
         for column, (field, higher_better) in enumerate(_COLUMN_FIELDS):
             if higher_better is None:
                 continue
@@ -95,6 +103,5 @@ def markdown_table(
                 if value == best:
                     cells[name][column] = f"**{cells[name][column]}**"
         for index, (name, row_cells) in enumerate(cells.items()):
-            first = str(group) if index == 0 else ""
-            lines.append("| " + " | ".join([first, str(name), *row_cells]) + " |")
-    return "\n".join(lines)
+            lines.append([str(group) if index == 0 else "", str(name), *row_cells])
+    return markdown_table([group_header, name_header, *TABLE_COLUMNS], lines, text_columns=2)
