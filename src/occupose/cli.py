@@ -273,8 +273,8 @@ def demo_cmd(out, scenario, frames, method) -> None:
               help="Folder for recordings/, runs/, results.csv, report.md and the plots (recordings are reused).")
 def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
-    from occupose.evaluation.evaluate import evaluate, table_rows
-    from occupose.evaluation.report import table_i_markdown
+    from occupose.evaluation.evaluate import evaluate
+    from occupose.evaluation.report import table_i_markdown, table_rows
 
     bars = []  # opened at the first report, once evaluate has checked its input and knows the total
 
