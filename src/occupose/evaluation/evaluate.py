@@ -40,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+from occupose._validate import positive_int
 from occupose.evaluation.errors import frame_errors, joint_errors
 from occupose.evaluation.matching import Score, match_tracks, score
 from occupose.evaluation.pixels import ARM_PARTS, arm_epsilons
@@ -116,12 +117,6 @@ def _names(given: Sequence[str] | str | None, valid: Sequence[str], default: Seq
     if len(set(names)) != len(names):
         raise ValueError(f"{what} named twice: {names}")
     return names
-
-
-def _positive_int(value, what: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"{what} must be an integer >= 1, got {value!r}")
-    return int(value)
 
 
 # --------------------------------------------------------------------------- tasks (run in workers)
@@ -287,9 +282,9 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
 
     scenarios = _names(scenarios, list(SCENARIOS), list(SCENARIOS), "scenario(s)")
     methods = _names(methods, list(METHODS), DEFAULT_METHODS, "method(s)")
-    runs = _positive_int(runs, "runs")
-    frames = None if frames is None else _positive_int(frames, "frames")
-    jobs = len(os.sched_getaffinity(0)) if jobs is None else _positive_int(jobs, "jobs")
+    runs = positive_int(runs, "runs")
+    frames = None if frames is None else positive_int(frames, "frames")
+    jobs = len(os.sched_getaffinity(0)) if jobs is None else positive_int(jobs, "jobs")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     lengths = {}
