@@ -17,6 +17,16 @@ from occupose.io.recording import Recording
 FRAMES = 20
 
 
+def test_the_package_exports_its_public_names_and_keeps_evaluate_a_module():
+    import types
+
+    import occupose.evaluation as evaluation
+    from occupose.evaluation.matching import score
+
+    assert set(evaluation.__all__) <= set(dir(evaluation)) and evaluation.score is score
+    assert isinstance(evaluation.evaluate, types.ModuleType) and evaluation.evaluate.evaluate is evaluate
+
+
 def test_bad_names_and_counts_are_refused_before_any_work(tmp_path):
     with pytest.raises(ValueError, match="unknown scenario.*'dance'; valid names: no_occlusion, sit_behind_table"):
         evaluate("dance", out=tmp_path / "a")
