@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import time
 
+from occupose.evaluation.report import markdown_table
+
 
 def median_seconds(function, repeats: int, warmup: int = 3, clock=time.perf_counter) -> tuple[float, float]:
     """(median, min) seconds of ``repeats`` calls of ``function()`` after ``warmup`` calls."""
@@ -25,13 +27,10 @@ def median_ms(function, repeats: int, warmup: int = 3, clock=time.perf_counter) 
 
 
 def format_table(title: str, rows: list[dict]) -> str:
-    """A markdown table of benchmark rows (dicts with the same keys), floats to 2 decimals."""
-    keys = list(rows[0])
-    lines = [f"### {title}", "", "| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    for row in rows:
-        cells = [f"{v:.2f}" if isinstance(v, float) else str(v) for v in row.values()]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+    """A markdown section: the title as a heading, then the table (occupose.evaluation.report's
+    writer) of benchmark rows (dicts with the same keys), floats to 2 decimals."""
+    cells = [[f"{v:.2f}" if isinstance(v, float) else str(v) for v in row.values()] for row in rows]
+    return f"### {title}\n\n" + markdown_table(list(rows[0]), cells)
 
 
 def print_table(title: str, rows: list[dict]) -> None:

@@ -34,7 +34,7 @@ from occupose.grid.baseline import DepthBackgroundSubtractor
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.occupancy import OccupancyGrid, cells_from_depth, spec_from_cameras
 from occupose.grid.spec import GridSpec
-from occupose.evaluation.metrics import foreground_scores
+from occupose.evaluation.pixels import foreground_scores
 from occupose.synth.body import primitives_from_joints
 from occupose.synth.generate import frames
 from occupose.geometry.primitives import concat

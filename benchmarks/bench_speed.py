@@ -17,7 +17,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from occupose.evaluation.metrics import pixel_assignment_accuracy
+from occupose.evaluation.pixels import pixel_assignment_accuracy
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.testing import persons_from_tracks

@@ -4,7 +4,7 @@ The second paper's Fig. 5 (arm error versus computing time per frame, 3D model v
 part-based) as a table and a plot, for every filter of occupose.filters on two scenes:
 ``no_occlusion`` (front view, ``full`` model) and ``top_view_arms`` (ceiling camera,
 ``upper`` model), with three errors: the mean joint error, the arm joints' error (elbows
-and wrists) and the paper's own arm error epsilon (occupose.evaluation.metrics.arm_epsilons: the
+and wrists) and the paper's own arm error epsilon (occupose.evaluation.pixels.arm_epsilons: the
 mean distance from the arm points to the arm bones; ``truth_eps_cm`` is the ground-truth
 skeleton's, the floor). As in issue 4's check:
 the ground-truth start pose, the person's own pixels from the renderer's person-id image
@@ -18,7 +18,7 @@ stage (3 full, 2 upper), apf+ps 5 layers over the stages ([3, 1, 1] full, [3, 2]
 Time per frame is the median of ``PoseEstimator.step`` (likelihood and filter; the
 observation is built beforehand); other processes share the 2 cores, so read it with the
 load column. Errors are means over seeds of the per-run mean; ``fails``
-counts the runs with the FAIL status (occupose.evaluation.metrics). The plot is saved as
+counts the runs with the FAIL status (occupose.evaluation.errors). The plot is saved as
 results/fig5_error_vs_time.png.
 """
 
@@ -33,7 +33,8 @@ import numpy as np
 from occupose.body import body_model, joints_from_pose, pose_from_joints
 from occupose.joints import JOINT_INDEX
 from occupose.evaluation.evaluate import ARM_SAMPLE
-from occupose.evaluation.metrics import ARM_PARTS, arm_epsilons, frame_errors, is_fail, joint_errors
+from occupose.evaluation.errors import frame_errors, is_fail, joint_errors
+from occupose.evaluation.pixels import ARM_PARTS, arm_epsilons
 from occupose.paths import mocap_dir
 from occupose.pose.estimator import PoseEstimator
 from occupose.pose.problem import PoseProblem

@@ -10,7 +10,7 @@ from PIL import Image
 from occupose.camera import raw_depth_from_metres
 from occupose.cli import main
 from occupose.config import TrackerConfig
-from occupose.evaluation.metrics import read_tracks_csv, write_tracks_csv
+from occupose.io.joint_table import read_tracks_csv, write_tracks_csv
 from occupose.io.recording import Recording, RecordingWriter
 from occupose.synth.scenarios import SCENARIOS
 

@@ -18,7 +18,7 @@ from occupose.grid.occupancy import (
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.spec import GridSpec
 from occupose.joints import JOINT_INDEX
-from occupose.evaluation.metrics import foreground_scores
+from occupose.evaluation.pixels import foreground_scores
 from occupose.synth.generate import frames
 from occupose.testing import capsules_from_primitives, foreground_from_grid
 from occupose.synth.body import primitives_from_joints, random_body_shape

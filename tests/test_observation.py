@@ -14,7 +14,7 @@ from occupose.grid.pixels import (
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
 from occupose.grid.tracking import BlobTracker
-from occupose.evaluation.metrics import foreground_scores, pixel_assignment_accuracy
+from occupose.evaluation.pixels import foreground_scores, pixel_assignment_accuracy
 from occupose.synth.body import primitives_from_joints
 from occupose.synth.noise import apply_noise
 from occupose.geometry.primitives import box, concat

@@ -8,7 +8,7 @@ import pytest
 from occupose.body.dims import DEFAULT_DIMS, dims_from_joints
 from occupose.camera import Camera, look_at
 from occupose.config import METHODS, ConfigError, ShapeConfig, StartConfig, TrackerConfig
-from occupose.evaluation.metrics import frame_errors, joint_errors
+from occupose.evaluation.errors import frame_errors, joint_errors
 from occupose.grid.pixels import PersonPixels
 from occupose.joints import JOINT_INDEX, JOINTS
 from occupose.pose.start import silhouette_fill

@@ -30,7 +30,7 @@ _EXPORTS = {
     "track_frames": "occupose.run",
     "write_run": "occupose.run",
     "TrackingResult": "occupose.run",
-    "score": "occupose.evaluation.metrics",
+    "score": "occupose.evaluation.matching",
 }
 
 __all__ = ["__version__", *_EXPORTS]

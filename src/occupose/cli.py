@@ -96,7 +96,7 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
               help="A tracks.csv to draw beside the ground truth.")
 def show_cmd(recording, index, out, tracks) -> None:
     """Write a PNG of one frame: depth colour-mapped, skeletons drawn over it."""
-    from occupose.evaluation.metrics import read_tracks_csv
+    from occupose.io.joint_table import read_tracks_csv
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
@@ -124,19 +124,21 @@ def score_cmd(recording, tracks) -> None:
 
 def score_text(rec, tracks_path: Path) -> str:
     """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person."""
-    from occupose.evaluation.metrics import format_table, read_tracks_csv, score
+    from occupose.evaluation.matching import score
+    from occupose.evaluation.report import TABLE_COLUMNS, markdown_table, table_i_cells
+    from occupose.io.joint_table import read_tracks_csv
 
     if not rec.has_groundtruth:
         raise ValueError(f"{rec.path}: no groundtruth.csv, nothing to score against")
     gt = rec.groundtruth()
     tracks = read_tracks_csv(tracks_path, rec.num_frames)
     result = score(gt.joints, gt.visible, {k: v[0] for k, v in tracks.items()}, rec.fps)
-    rows = {}
+    rows = []
     for pid, person in zip(gt.person_ids, result.persons):
         track = "none" if person.track is None else f"track {person.track}"
-        rows[f"person {pid} ({track}) all joints"] = person.all_joints
-        rows[f"person {pid} ({track}) visible joints"] = person.visible_joints
-    lines = [format_table(rows, name_header="person")]
+        rows.append([f"person {pid} ({track}) all joints", *table_i_cells(person.all_joints)])
+        rows.append([f"person {pid} ({track}) visible joints", *table_i_cells(person.visible_joints)])
+    lines = [markdown_table(["person", *TABLE_COLUMNS], rows, text_columns=1)]
     lines.append(f"identity switches: {result.identity_switches}; unmatched tracks: "
                  f"{list(result.unmatched_tracks) or 'none'}")
     return "\n".join(lines)
@@ -276,7 +278,7 @@ def config_cmd(method, config_file, assignments) -> None:
 def demo_cmd(out, scenario, frames, method) -> None:
     """Render a built-in scenario with procedural motion (no shared data needed), track it,
     print the Table I row and picture a frame with the skeletons."""
-    from occupose.evaluation.metrics import read_tracks_csv
+    from occupose.io.joint_table import read_tracks_csv
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
@@ -316,8 +318,8 @@ def demo_cmd(out, scenario, frames, method) -> None:
               help="Folder for recordings/, runs/, results.csv, report.md and the plots (recordings are reused).")
 def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
-    from occupose.evaluation.evaluate import evaluate, table_rows
-    from occupose.evaluation.metrics import markdown_table
+    from occupose.evaluation.evaluate import evaluate
+    from occupose.evaluation.report import table_i_markdown, table_rows
 
     bars = []  # opened at the first report, once evaluate has checked its input and knows the total
 
@@ -334,5 +336,5 @@ def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> Non
     finally:
         for bar in bars:
             bar.close()
-    click.echo(markdown_table(table_rows(result.runs)))
+    click.echo(table_i_markdown(table_rows(result.runs)))
     click.echo(f"report: {result.report}\nresults: {result.results}\nplots: {len(result.plots)} in {out}")

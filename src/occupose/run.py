@@ -126,7 +126,7 @@ def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: st
               method: str | None = None) -> Path:
     """Write ``out``/tracks.csv and ``out``/summary.json (:func:`summary_of`); returns the
     tracks.csv path. ``out`` is made if it does not exist."""
-    from occupose.evaluation.metrics import write_tracks_csv
+    from occupose.io.joint_table import write_tracks_csv
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -31,7 +31,7 @@ from occupose.body import body_model, capsules_from_poses, joints_from_pose, joi
 from occupose.config import PriorConfig
 from occupose.joints import JOINT_INDEX
 from occupose.likelihood import Observation, View, observation_from_views, point_distances
-from occupose.evaluation.metrics import frame_errors, is_fail, joint_errors, table_row
+from occupose.evaluation.errors import frame_errors, is_fail, joint_errors, table_row
 from occupose.pose.estimator import PoseEstimator
 from occupose.pose.problem import (
     PoseProblem,

@@ -10,13 +10,12 @@
 
 A camera has colour when its ``color`` folder exists; it then has a colour image for
 every frame. Ground truth has one row per frame, person and known joint; joints with
-no row are unknown (NaN). Everything wrong with a recording is reported as a
+no row are unknown (NaN); `occupose.io.joint_table` reads and writes it. Everything wrong with a recording is reported as a
 RecordingError (a ValueError) or FileNotFoundError whose message names the file.
 """
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import os
@@ -28,13 +27,13 @@ import numpy as np
 from PIL import Image, UnidentifiedImageError
 
 from occupose.camera import Camera, camera_from_dict
-from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS
+from occupose.io.joint_table import JointTableError, read_joint_table, write_joint_table
+from occupose.joints import NUM_JOINTS
 
 FORMAT = "occupose-recording"
 VERSION = 1
 SUPPORTED_VERSIONS: tuple[int, ...] = (1,)
 RECORDING_KEYS: tuple[str, ...] = ("format", "version", "fps", "num_frames", "cameras")
-GROUNDTRUTH_COLUMNS: tuple[str, ...] = ("frame", "person", "joint", "x", "y", "z", "visible")
 
 _JSON_NAME = "recording.json"
 _GROUNDTRUTH_NAME = "groundtruth.csv"
@@ -196,7 +195,7 @@ class RecordingWriter:
         joints : (T, P, 15, 3) float, metres, world frame; NaN where unknown (person absent);
             each joint is either fully finite or fully NaN
         visible : (T, P, 15) bool
-        person_ids : P distinct ints
+        person_ids : P distinct ints (rows are written by frame, then increasing id, then joint)
         """
         self._check_open()
         if self._groundtruth_frames is not None:
@@ -210,15 +209,8 @@ class RecordingWriter:
             raise ValueError(f"visible must be bool of shape {joints.shape[:3]}, got {visible.dtype} {visible.shape}")
         if len(ids) != joints.shape[1] or len(set(ids)) != len(ids):
             raise ValueError(f"person_ids must be {joints.shape[1]} distinct ints, got {list(person_ids)}")
-        finite = np.isfinite(joints)
-        known = finite.all(axis=-1)
-        if np.any(np.isinf(joints)) or np.any(finite.any(axis=-1) & ~known):
-            raise ValueError("joints must be fully finite or fully NaN per joint; some have inf or a partial NaN")
-        lines = [",".join(GROUNDTRUTH_COLUMNS)]
-        for t, p, j in zip(*np.nonzero(known)):
-            x, y, z = joints[t, p, j]
-            lines.append(f"{t},{ids[p]},{JOINTS[j]},{x:.5f},{y:.5f},{z:.5f},{int(visible[t, p, j])}")
-        (self.path / _GROUNDTRUTH_NAME).write_text("\n".join(lines) + "\n")
+        write_joint_table(self.path / _GROUNDTRUTH_NAME,
+                          {ids[p]: (joints[:, p], visible[:, p]) for p in range(len(ids))}, "groundtruth")
         self._groundtruth_frames = joints.shape[0]
 
     def close(self) -> None:
@@ -421,68 +413,15 @@ class Recording:
         if not file.is_file():
             raise FileNotFoundError(f"{file}: no such file; this recording has no ground truth")
         try:
-            rows = _read_groundtruth_rows(file, self.num_frames)
-        except (UnicodeDecodeError, csv.Error) as error:
-            raise RecordingError(f"{file}: not a readable UTF-8 CSV file ({error})") from None
-        person_ids = tuple(sorted({person for _, person, *_ in rows}))
-        column = {person: p for p, person in enumerate(person_ids)}
+            table = read_joint_table(file, self.num_frames, "groundtruth")
+        except JointTableError as error:
+            raise RecordingError(str(error)) from None
+        person_ids = tuple(sorted(table))
         joints = np.full((self.num_frames, len(person_ids), NUM_JOINTS, 3), np.nan)
         visible = np.zeros(joints.shape[:3], dtype=bool)
-        for frame, person, joint, xyz, flag in rows:
-            joints[frame, column[person], joint] = xyz
-            visible[frame, column[person], joint] = flag
+        for p, person in enumerate(person_ids):
+            joints[:, p], visible[:, p] = table[person]
         return GroundTruth(joints=joints, visible=visible, person_ids=person_ids)
-
-
-def _read_groundtruth_rows(file: Path, num_frames: int) -> list[tuple[int, int, int, tuple[float, float, float], bool]]:
-    """Parse and check ``groundtruth.csv``: rows of (frame, person, joint index, (x, y, z), visible)."""
-    with open(file, newline="", encoding="utf-8") as handle:
-        reader = csv.reader(handle)
-        header = next(reader, None)
-        columns = [c.strip() for c in header] if header is not None else []
-        if columns not in (list(GROUNDTRUTH_COLUMNS), list(GROUNDTRUTH_COLUMNS[:-1])):
-            raise RecordingError(
-                f"{file}: bad header {columns}; expected columns {','.join(GROUNDTRUTH_COLUMNS)} (visible optional)"
-            )
-        has_visible = len(columns) == len(GROUNDTRUTH_COLUMNS)
-        rows = []
-        seen = set()
-        for line, values in enumerate(reader, start=2):
-            if not values:
-                continue
-            where = f"{file} line {line}"
-            if len(values) != len(columns):
-                raise RecordingError(f"{where}: expected {len(columns)} values, got {len(values)}: {values}")
-            try:
-                frame, person = int(values[0]), int(values[1])
-            except ValueError:
-                raise RecordingError(
-                    f"{where}: frame and person must be integers, got {values[0]!r}, {values[1]!r}"
-                ) from None
-            if not 0 <= frame < num_frames:
-                raise RecordingError(
-                    f"{where}: frame {frame} out of range; the recording has frames 0..{num_frames - 1}"
-                )
-            name = values[2].strip()
-            if name not in JOINT_INDEX:
-                raise RecordingError(f"{where}: unknown joint {name!r}; valid joints: {', '.join(JOINTS)}")
-            try:
-                xyz = tuple(float(v) for v in values[3:6])
-            except ValueError:
-                raise RecordingError(f"{where}: x, y, z must be numbers, got {values[3:6]}") from None
-            if not all(math.isfinite(v) for v in xyz):
-                raise RecordingError(f"{where}: x, y, z must be finite, got {values[3:6]}")
-            flag = True
-            if has_visible:
-                if values[6].strip() not in ("0", "1"):
-                    raise RecordingError(f"{where}: visible must be 0 or 1, got {values[6]!r}")
-                flag = values[6].strip() == "1"
-            key = (frame, person, JOINT_INDEX[name])
-            if key in seen:
-                raise RecordingError(f"{where}: duplicate row for frame {frame}, person {person}, joint {name}")
-            seen.add(key)
-            rows.append((frame, person, JOINT_INDEX[name], xyz, flag))
-    return rows
 
 
 def open_recording(path: str | os.PathLike) -> Recording:

@@ -1,5 +1,4 @@
-"""occupose.evaluation.evaluate: the report and table formatting on hand-made scores, and one tiny
-evaluation end to end (no_occlusion, 20 procedural frames, `ours`) through the command line."""
+"""occupose.evaluation.report: the tables, results.csv and the report on hand-made rows and runs."""
 
 import csv
 import math
@@ -7,21 +6,74 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
-from occupose.cli import main
-from occupose.evaluation.evaluate import (
-    RunResult, arm_points, evaluate, hidden_share, intervals_from_mask, mean_row, per_joint_table, render_recording,
-    report_markdown, results_table, table_rows, write_results_csv,
+from occupose.evaluation.errors import TableRow
+from occupose.evaluation.evaluate import RunResult
+from occupose.evaluation.matching import PersonScore, Score
+from occupose.evaluation.report import (
+    hidden_share,
+    intervals_from_mask,
+    markdown_table,
+    mean_row,
+    number_cell,
+    per_joint_table,
+    report_markdown,
+    results_table,
+    table_i_cells,
+    table_i_markdown,
+    table_rows,
+    write_results_csv,
 )
 from occupose.joints import JOINTS
-from occupose.evaluation.metrics import PersonScore, Score, TableRow, arm_epsilons, read_tracks_csv
-from occupose.io.recording import Recording
-
-FRAMES = 20
 
 
-def _row(mean_cm, fail=False, under10=50.0, coverage=100.0):
+# --------------------------------------------------------------------------- tables
+
+
+def _row(**changes):
+    values = dict(mean_cm=12.0, std_cm=5.0, under10=30.0, under15=60.0, under20=80.0,
+                  over20=20.0, fail=False, frames=100, coverage=100.0)
+    values.update(changes)
+    return TableRow(**values)
+
+
+def test_markdown_table_rule_follows_the_alignment():
+    assert markdown_table(["a", "b", "c"], [["x", "1", "2"]], text_columns=1) == (
+        "| a | b | c |\n|---|---:|---:|\n| x | 1 | 2 |")
+    assert markdown_table(["a", "b"], [], text_columns=2) == "| a | b |\n|---|---|"
+    assert markdown_table(["a", "b"], [["x", "y"]]).splitlines()[1] == "|---|---|"  # no alignment
+    with pytest.raises(ValueError, match=r"a row of 2 columns \['a', 'b'\] has 1 cells"):
+        markdown_table(["a", "b"], [["x"]])
+
+
+def test_table_i_cells_and_the_one_line_summary():
+    assert table_i_cells(_row()) == ["30.00", "60.00", "80.00", "20.00", "12.00", "5.00", "ok", "100.00"]
+    assert table_i_cells(_row(mean_cm=math.nan, fail=True))[4:7] == ["n/a", "5.00", "FAIL"]
+    assert number_cell(math.nan) == "n/a" and number_cell(2.345, 1) == "2.3"
+    assert "avg 12.00 cm" in _row().format() and "ok" in _row().format()
+
+
+def test_table_i_markdown_bolds_best_per_group():
+    groups = {
+        "Seq1": {"OUR": _row(mean_cm=10.0, under10=50.0), "APF": _row(mean_cm=15.0, under10=50.0, std_cm=4.0)},
+        "Seq2": {"OUR": _row(over20=math.nan)},
+    }
+    lines = table_i_markdown(groups).splitlines()
+    assert lines[0].startswith("| sequence | method | <10cm [%]")
+    our, apf, seq2 = (line.split(" | ") for line in lines[2:5])
+    assert our[0] == "| Seq1" and apf[0] == "| " and seq2[0] == "| Seq2"
+    assert our[2] == "**50.00**" and apf[2] == "**50.00**"  # tie: both bold
+    assert our[6] == "**10.00**" and apf[6] == "15.00"  # lower mean is better
+    assert our[7] == "5.00" and apf[7] == "**4.00**"
+    assert our[8] == "ok"  # status not ranked
+    assert seq2[5] == "n/a" and seq2[6] == "**12.00**"
+
+
+# --------------------------------------------------------------------------- runs
+
+
+def _mean_row(mean_cm, fail=False, under10=50.0, coverage=100.0):
+    """A TableRow of mean ``mean_cm`` (cm) and std a quarter of it."""
     return TableRow(mean_cm=mean_cm, std_cm=mean_cm / 4, under10=under10, under15=60.0, under20=70.0,
                     over20=30.0, fail=fail, frames=100, coverage=coverage)
 
@@ -29,7 +81,7 @@ def _row(mean_cm, fail=False, under10=50.0, coverage=100.0):
 def _run(scenario, method, seed, means, fails=None, fps=20.0, switches=0, joints=JOINTS):
     """A RunResult with one person per entry of ``means`` (cm)."""
     fails = fails or [False] * len(means)
-    persons = tuple(PersonScore(track=k + 1, all_joints=_row(m, f), visible_joints=_row(m - 1.0, f),
+    persons = tuple(PersonScore(track=k + 1, all_joints=_mean_row(m, f), visible_joints=_mean_row(m - 1.0, f),
                                 per_joint_cm={j: m for j in joints}, identity_switches=switches)
                     for k, (m, f) in enumerate(zip(means, fails)))
     return RunResult(scenario, method, seed, Score(persons, (), switches * len(means)),
@@ -46,17 +98,16 @@ def runs():
     ]
 
 
-# --------------------------------------------------------------------------- tables on hand-made scores
 
 
 def test_mean_row_averages_each_number_and_fails_when_any_run_fails():
-    row = mean_row([_row(8.0), _row(10.0, fail=True, under10=70.0), _row(math.nan, coverage=0.0)])
+    row = mean_row([_mean_row(8.0), _mean_row(10.0, fail=True, under10=70.0), _mean_row(math.nan, coverage=0.0)])
     assert row.mean_cm == pytest.approx(9.0)  # the run without estimates is left out
     assert row.std_cm == pytest.approx(2.25)
     assert row.under10 == pytest.approx(170.0 / 3)
     assert row.coverage == pytest.approx(200.0 / 3)
     assert row.fail is True and row.frames == 100
-    assert mean_row([_row(8.0), _row(9.0)]).fail is False
+    assert mean_row([_mean_row(8.0), _mean_row(9.0)]).fail is False
     with pytest.raises(ValueError, match="at least one row"):
         mean_row([])
 
@@ -144,84 +195,26 @@ def test_intervals_and_hidden_share():
     assert share[0, 0] == pytest.approx(10 / 15) and np.isnan(share[1, 0])
 
 
-def test_bad_names_and_counts_are_refused_before_any_work(tmp_path):
-    with pytest.raises(ValueError, match="unknown scenario.*'dance'; valid names: no_occlusion, sit_behind_table"):
-        evaluate("dance", out=tmp_path / "a")
-    with pytest.raises(ValueError, match="unknown method.*'kalman'; valid names: ours, apf, ps, part-based"):
-        evaluate(["no_occlusion"], ["ours", "kalman"], out=tmp_path / "a")
-    with pytest.raises(ValueError, match="runs must be an integer >= 1, got 0"):
-        evaluate("no_occlusion", "ours", 0, out=tmp_path / "a")
-    with pytest.raises(ValueError, match="named twice"):
-        evaluate("no_occlusion,no_occlusion", "ours", out=tmp_path / "a")
-    assert not (tmp_path / "a").exists()
-    result = CliRunner().invoke(main, ["evaluate", "--scenarios", "dance", "--out", str(tmp_path / "b")])
-    assert result.exit_code != 0 and "valid names: no_occlusion" in result.output
+def test_plots_use_the_figure_api_only(tmp_path, monkeypatch):
+    import sys
 
+    import matplotlib
 
-# --------------------------------------------------------------------------- end to end
+    from occupose.camera import Camera
+    from occupose.evaluation.report import write_plots
+    from occupose.io.recording import RecordingWriter
 
-
-@pytest.fixture(scope="module")
-def evaluated(tmp_path_factory):
-    out = tmp_path_factory.mktemp("evaluate")
-    result = CliRunner().invoke(main, ["evaluate", "--scenarios", "no_occlusion", "--methods", "ours", "--runs", "1",
-                                       "--frames", str(FRAMES), "--procedural", "--jobs", "1", "--out", str(out)])
-    assert result.exit_code == 0, result.output
-    return out, result.output
-
-
-def test_evaluate_writes_runs_results_report_and_plots(evaluated):
-    out, output = evaluated
-    assert "| no_occlusion | ours |" in output and str(out / "report.md") in output
-    assert (out / "recordings" / "no_occlusion" / "recording.json").is_file()
-    assert (out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv").is_file()
-    with (out / "results.csv").open() as handle:
-        rows = list(csv.DictReader(handle))
-    assert [(r["scenario"], r["method"], r["seed"], r["person"]) for r in rows] == [("no_occlusion", "ours", "0", "1")]
-    assert 0 < float(rows[0]["mean_cm"]) < 20 and rows[0]["fail"] == "0" and float(rows[0]["fps"]) > 0
-    # the arm error of the ground truth is about an arm's radius (4-5 cm) plus the hands beyond
-    # the wrists; the track's is its own, from its tracks.csv and the recording's arm pixels
-    truth_eps, eps = float(rows[0]["truth_arm_eps_cm"]), float(rows[0]["arm_eps_cm"])
-    assert 3.0 < truth_eps < 7.0 and truth_eps < eps < truth_eps + 5.0
-    rec = Recording(out / "recordings" / "no_occlusion")
-    arms = arm_points(rec, rec.groundtruth().person_ids)
-    (track,) = read_tracks_csv(out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv", FRAMES).values()
-    assert 100 * np.nanmean(arm_epsilons(arms[0], track[0])) == pytest.approx(eps, abs=1e-4)
-    report = (out / "report.md").read_text()
-    assert "| no_occlusion | ours |" in report and "**" in report
-    assert f"| no_occlusion | {eps:.2f} | {truth_eps:.2f} |" in report
-    for name in ("error_no_occlusion.png", "error_vs_time.png"):
-        assert (out / name).stat().st_size > 10_000 and f"]({name})" in report
-
-
-def test_evaluate_reuses_the_recording_and_runs_in_workers_as_in_process(evaluated):
-    out, _ = evaluated
-    recording = out / "recordings" / "no_occlusion" / "recording.json"
-    stamp = recording.stat().st_mtime_ns
-    in_process = (out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv").read_text()
-    seen = []
-    result = evaluate("no_occlusion", "ours", 2, out=out, frames=FRAMES, procedural=True, jobs=2,
-                      progress=lambda n, total: seen.append((n, total)))
-    assert recording.stat().st_mtime_ns == stamp  # same settings: not rendered again
-    assert sum(n for n, _ in seen) == 3 * FRAMES and {t for _, t in seen} == {3 * FRAMES}
-    assert [(r.scenario, r.method, r.seed) for r in result.runs] == [("no_occlusion", "ours", 0), ("no_occlusion", "ours", 1)]
-    assert (out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv").read_text() == in_process
-
-
-def test_a_recording_of_motion_the_scenario_no_longer_makes_is_rendered_again(tmp_path, monkeypatch):
-    from occupose.synth import scenarios
-
-    out = tmp_path / "no_occlusion"
-    render_recording("no_occlusion", out, 3, procedural=True)
-    stamp = (out / "recording.json").stat().st_mtime_ns
-    render_recording("no_occlusion", out, 3, procedural=True)
-    assert (out / "recording.json").stat().st_mtime_ns == stamp  # the same: kept
-    build = scenarios.build_scenario
-
-    def moved(*args, **kwargs):  # the same settings, the person 1 cm further along x
-        built = build(*args, **kwargs)
-        return replace(built, people=tuple(replace(p, joints=p.joints + [0.01, 0.0, 0.0]) for p in built.people))
-
-    monkeypatch.setattr(scenarios, "build_scenario", moved)
-    render_recording("no_occlusion", out, 3, procedural=True)
-    assert (out / "recording.json").stat().st_mtime_ns != stamp
+    joints = np.zeros((100, 1, 15, 3))
+    joints[..., 2] = np.linspace(0.1, 1.7, 15)
+    visible = np.ones((100, 1, 15), bool)
+    visible[30:60, 0, :12] = False  # mostly hidden for a second
+    with RecordingWriter(tmp_path / "tiny", [Camera("cam0", 8, 6, 5.0, 5.0, 3.5, 2.5)], fps=30.0) as writer:
+        for _ in range(100):
+            writer.write_frame({"cam0": np.zeros((6, 8), np.uint16)})
+        writer.write_groundtruth(joints, visible, [1])
+    monkeypatch.setitem(sys.modules, "matplotlib.pyplot", None)  # importing pyplot now fails
+    monkeypatch.setattr(matplotlib, "use", lambda *args, **kwargs: pytest.fail("matplotlib.use called"))
+    runs = [_run("tiny", "ours", seed, [8.0 + seed]) for seed in range(2)] + [_run("tiny", "apf", 0, [12.0])]
+    paths = write_plots(runs, tmp_path, {"tiny": tmp_path / "tiny"}, {"tiny": {"sit": (10, 40)}})
+    assert paths == [tmp_path / "error_tiny.png", tmp_path / "error_vs_time.png"]
+    assert all(path.stat().st_size > 10_000 for path in paths)

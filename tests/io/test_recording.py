@@ -381,12 +381,12 @@ def test_groundtruth_unknown_joint(rec):
 
 
 def test_groundtruth_wrong_number_of_values(rec):
-    groundtruth_error(rec, "frame,person,joint,x,y,z,visible\n0,1,head,0,0,1\n", "line 2: expected 7 values, got 6")
+    groundtruth_error(rec, "frame,person,joint,x,y,z,visible\n0,1,head,0,0,1\n", "line 2: expected 7 columns, got 6")
 
 
 def test_groundtruth_non_integer_frame(rec):
     groundtruth_error(rec, "frame,person,joint,x,y,z,visible\n0.5,1,head,0,0,1,1\n",
-                      "line 2: frame and person must be integers, got '0.5', '1'")
+                      "line 2: frame must be an integer, got '0.5'")
 
 
 def test_groundtruth_frame_out_of_range(rec):
@@ -396,11 +396,11 @@ def test_groundtruth_frame_out_of_range(rec):
 
 def test_groundtruth_bad_coordinate(rec):
     groundtruth_error(rec, "frame,person,joint,x,y,z,visible\n0,1,head,abc,0,1,1\n",
-                      r"line 2: x, y, z must be numbers, got \['abc', '0', '1'\]")
+                      "line 2: x must be a number, got 'abc'")
 
 
 def test_groundtruth_non_finite_coordinate(rec):
-    groundtruth_error(rec, "frame,person,joint,x,y,z,visible\n0,1,head,nan,0,1,1\n", "line 2: x, y, z must be finite")
+    groundtruth_error(rec, "frame,person,joint,x,y,z,visible\n0,1,head,nan,0,1,1\n", "line 2: x must be finite, got 'nan'")
 
 
 def test_groundtruth_bad_visible_flag(rec):
