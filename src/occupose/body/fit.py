@@ -1,4 +1,4 @@
-"""Poses fitted to canonical joints: ground-truth initialisation and standing guesses.
+"""Poses fitted to canonical joints (ground-truth initialisation, resizing a model), and a limb's angles.
 
 :func:`pose_from_joints` solves the root and every limb analytically from joint
 directions (the torso frame from the pelvis -> neck axis and the hip and shoulder lines, then
@@ -19,7 +19,6 @@ from occupose.body.kinematics import joints_from_poses
 from occupose.body.model import BodyModel
 from occupose.joints import JOINT_INDEX as J
 from occupose.joints import NUM_JOINTS
-from occupose.synth import motion as sm
 
 #: Weight of the pull towards the analytic pose, metres of joint error per radian.
 PRIOR_WEIGHT = 1e-3
@@ -199,11 +198,3 @@ def pose_from_joints(model: BodyModel, joints, *, refine: bool = True) -> np.nda
     result = least_squares(residuals, start, jac=jacobian, bounds=(lo, hi), method="trf",
                            x_scale=1.0, xtol=1e-10, ftol=1e-10, max_nfev=200)
     return _inside(model, result.x)
-
-
-def standing_pose(model: BodyModel, xy=(0.0, 0.0), heading: float = 0.0) -> np.ndarray:
-    """A relaxed upright pose (D,) of ``model``: pelvis above ``xy`` (metres), facing
-    ``heading`` (radians about +z, 0 = +x), arms hanging (the procedural generator's stance
-    for the model's dims, fitted)."""
-    joints = sm.joints_from_procedural(sm.stance(xy, heading, model.dims), model.dims)
-    return pose_from_joints(model, joints)

@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from occupose.body import BodyModel, body_model, dims_from_observation, pose_from_joints
+from occupose.body import BodyModel, body_model, dims_from_observation, seated_pose, standing_pose
 from occupose.body.size import top_height
 from occupose.camera import Camera
 from occupose.config import StartConfig, TrackerConfig
@@ -25,7 +25,6 @@ from occupose.grid.pixels import PersonPixels
 from occupose.likelihood import observation_from_views
 from occupose.pose.person import Person
 from occupose.pose.views import at_border, views_from_pixels
-from occupose.synth import motion as procedural
 
 
 def person_like(pixels: PersonPixels, cameras: Sequence[Camera], config: StartConfig, top_rank: int) -> bool:
@@ -79,20 +78,14 @@ def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera, c
 def start_candidates(model: BodyModel, centroid: np.ndarray, headings: np.ndarray,
                      seat_share: float = StartConfig.seat_share) -> np.ndarray:
     """(S, D) start poses for a person whose blob is centred at ``centroid`` (3,) metres:
-    standing and (for models with legs) sitting on a seat ``seat_share`` of the stature
-    high, at every heading of ``headings`` (radians), the pelvis above the centroid."""
-    poses = []
-    postures = [procedural.stance((0.0, 0.0), 0.0, model.dims)]
-    if any("knee" in n for n in model.dof_names):
-        standing = postures[0]
-        postures.append(procedural.sit_down(standing, seat_share * model.dims.height, dims=model.dims)[-1])
-    for posture in postures:
-        fitted = pose_from_joints(model, procedural.joints_from_procedural(posture[None], model.dims)[0])
-        for heading in headings:
-            pose = fitted.copy()
-            pose[model.dof_names.index("heading")] = heading
-            poses.append(pose)
-    poses = np.array(poses)
+    standing and (for models with legs) seated on a seat ``seat_share`` of the stature
+    high (:mod:`occupose.body.postures`), at every heading of ``headings`` (radians), the
+    pelvis above the centroid."""
+    postures = [standing_pose(model)]
+    if "left_knee" in model.dof_names:
+        postures.append(seated_pose(model, seat_share * model.dims.height))
+    poses = np.repeat(np.array(postures), len(headings), axis=0)
+    poses[:, model.dof("heading")] = np.tile(headings, len(postures))
     poses[:, 0:2] = centroid[:2]  # pelvis above the blob's centre; the filter settles the rest
     return poses
 
