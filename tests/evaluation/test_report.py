@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from occupose.evaluation.errors import TableRow
-from occupose.evaluation.evaluate import RunResult
+from occupose.evaluation.report import RunResult
 from occupose.evaluation.matching import PersonScore, Score
 from occupose.evaluation.report import (
     hidden_share,

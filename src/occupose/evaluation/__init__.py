@@ -22,7 +22,7 @@ from occupose.evaluation.errors import (
     rolling_mean,
     table_row,
 )
-from occupose.evaluation.evaluate import Evaluation, RunResult, run_method
+from occupose.evaluation.evaluate import Evaluation, run_method
 from occupose.evaluation.matching import PersonScore, Score, identity_switches, match_tracks, score
 from occupose.evaluation.pixels import (
     arm_epsilons,
@@ -31,6 +31,7 @@ from occupose.evaluation.pixels import (
     segment_distances,
 )
 from occupose.evaluation.report import (
+    RunResult,
     markdown_table,
     mean_row,
     per_joint_table,

@@ -33,7 +33,7 @@ import os
 import queue as queue_module
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -41,9 +41,9 @@ import numpy as np
 
 from occupose._validate import positive_int
 from occupose.evaluation.errors import frame_errors, joint_errors
-from occupose.evaluation.matching import Score, match_tracks, score
+from occupose.evaluation.matching import match_tracks, score
 from occupose.evaluation.pixels import ARM_PARTS, arm_epsilons
-from occupose.evaluation.report import report_markdown, write_plots, write_results_csv
+from occupose.evaluation.report import RunResult, report_markdown, write_plots, write_results_csv
 
 #: Methods compared when none are named.
 DEFAULT_METHODS: tuple[str, ...] = ("ours", "apf", "ps")
@@ -57,33 +57,6 @@ Progress = Callable[[int, int], None]
 
 
 # --------------------------------------------------------------------------- results
-
-
-@dataclass(frozen=True)
-class RunResult:
-    """One method on one scenario with one seed.
-
-    score : the Table I scores of every ground-truth person (occupose.evaluation.matching.Score)
-    person_ids : ground-truth person ids, in the order of ``score.persons``
-    frame_errors : (T, P) float64, metres: D_t of each person over the joints the matched
-        track reports (NaN where the person is not counted or has no estimate)
-    fps : frames per second of tracking, start-up excluded
-    seconds : seconds per stage, ``total`` and ``startup`` (TrackingResult.seconds)
-    arm_epsilon, truth_arm_epsilon : (T, P) float64, metres, or None for a recording
-        without part labels: the second paper's arm error (pixels.arm_epsilons) of each
-        person's matched track (NaN without an estimate) and of its ground truth
-    """
-
-    scenario: str
-    method: str
-    seed: int
-    score: Score
-    person_ids: tuple[int, ...]
-    frame_errors: np.ndarray
-    fps: float
-    seconds: dict[str, float] = field(default_factory=dict)
-    arm_epsilon: np.ndarray | None = None
-    truth_arm_epsilon: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -344,4 +317,4 @@ def _drain(frames_done, progress) -> None:
         progress(count)
 
 
-__all__ = ["DEFAULT_METHODS", "Evaluation", "RunResult", "arm_points", "evaluate", "render_recording", "run_method"]
+__all__ = ["DEFAULT_METHODS", "Evaluation", "arm_points", "evaluate", "render_recording", "run_method"]

@@ -18,19 +18,45 @@ from __future__ import annotations
 import csv
 import math
 import os
-from dataclasses import fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
 from occupose.evaluation.errors import TableRow
+from occupose.evaluation.matching import Score
 from occupose.evaluation.pixels import MIN_ARM_POINTS
 from occupose.io.recording import Recording
 from occupose.joints import JOINTS
 
-if TYPE_CHECKING:
-    from occupose.evaluation.evaluate import RunResult
+
+@dataclass(frozen=True)
+class RunResult:
+    """One method on one scenario with one seed.
+
+    score : the Table I scores of every ground-truth person (occupose.evaluation.matching.Score)
+    person_ids : ground-truth person ids, in the order of ``score.persons``
+    frame_errors : (T, P) float64, metres: D_t of each person over the joints the matched
+        track reports (NaN where the person is not counted or has no estimate)
+    fps : frames per second of tracking, start-up excluded
+    seconds : seconds per stage, ``total`` and ``startup`` (TrackingResult.seconds)
+    arm_epsilon, truth_arm_epsilon : (T, P) float64, metres, or None for a recording
+        without part labels: the second paper's arm error (pixels.arm_epsilons) of each
+        person's matched track (NaN without an estimate) and of its ground truth
+    """
+
+    scenario: str
+    method: str
+    seed: int
+    score: Score
+    person_ids: tuple[int, ...]
+    frame_errors: np.ndarray
+    fps: float
+    seconds: dict[str, float] = field(default_factory=dict)
+    arm_epsilon: np.ndarray | None = None
+    truth_arm_epsilon: np.ndarray | None = None
+
 
 #: A frame is shaded in the error plots where at least this share of a present person's
 #: joints is hidden in the ground truth (light), or at least MOSTLY_HIDDEN (dark).
@@ -115,13 +141,13 @@ def table_i_markdown(
     lines = []
     for group, rows in groups.items():
         cells = {name: table_i_cells(row) for name, row in rows.items()}
-        for column, (field, higher_better) in enumerate(_COLUMN_FIELDS):
+        for column, (name_of_field, higher_better) in enumerate(_COLUMN_FIELDS):
             if higher_better is None:
                 continue
             printed = {
-                name: round(getattr(row, field), 2)
+                name: round(getattr(row, name_of_field), 2)
                 for name, row in rows.items()
-                if not math.isnan(getattr(row, field))
+                if not math.isnan(getattr(row, name_of_field))
             }
             if not printed:
                 continue
