@@ -16,9 +16,9 @@ from occupose.config import (
     ConfigError,
     PoseConfig,
     TrackerConfig,
-    configuration_markdown,
     method_config,
 )
+from occupose.config_docs import configuration_markdown
 from occupose.run import TrackingResult, summary_of
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "configuration.md"
@@ -117,5 +117,5 @@ def test_every_field_has_a_meaning_and_the_docs_list_them_all():
         for f in dataclasses.fields(section.default_factory):
             assert f.metadata.get("doc"), f"{section.name}.{f.name} has no meaning"
     assert DOCS.read_text() == configuration_markdown(), (
-        "docs/configuration.md is out of date: python -c \"from occupose.config import configuration_markdown "
+        "docs/configuration.md is out of date: python -c \"from occupose.config_docs import configuration_markdown "
         "as m; print(m(), end='')\" > docs/configuration.md")

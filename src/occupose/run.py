@@ -85,7 +85,7 @@ def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: 
     tracker.close()
     fps = (num_frames - 1) / total if num_frames > 1 and total > 0 else 0.0
     return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, dict(seconds, total=total,
-                          startup=startup), fps, num_frames, tracker.config, 0, tracker.model_name)
+                          startup=startup), fps, num_frames, tracker.config, tracker.seed, tracker.model_name)
 
 
 def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: int = 0,
@@ -108,9 +108,7 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
                          f"{type(recording).__name__}")
     config = method_config(config) if isinstance(config, str) else config
     tracker = Tracker(recording.cameras, recording.fps, config, seed=seed)
-    result = track_frames(tracker, recording.frames(), recording.num_frames, progress, overlap=overlap)
-    result.seed = seed
-    return result
+    return track_frames(tracker, recording.frames(), recording.num_frames, progress, overlap=overlap)
 
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:

@@ -106,6 +106,7 @@ class Tracker:
                                  fragment_m=blobs.fragment_m, min_share=blobs.min_share,
                                  position_gain=blobs.position_gain, velocity_gain=blobs.velocity_gain)
         self.people: dict[int, Person] = {}
+        self.seed = seed
         self._seeds = np.random.SeedSequence(seed)
         self._previous = {}
         self._pending: dict[int, list[np.ndarray]] = {}  # points of tracks not yet started
