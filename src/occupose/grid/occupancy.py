@@ -15,7 +15,7 @@ edges blurred by the sensor's depth noise::
 
 with ``h`` half the cell's extent along the optical axis, ``cell / 2 * (|r_x| + |r_y| + |r_z|)``
 for the camera's viewing direction ``r`` in world axes, and ``w = tail_width * s`` where ``s``
-is the sensor's random depth error at that distance (:func:`occupose.synth.noise.depth_std`
+is the sensor's random depth error at that distance (:func:`occupose.sensors.depth_std`
 of the camera's noise model; ``tail_width`` 2 by default). The tails stop at ``band = h + 3 w``,
 beyond which f is exactly ``p_free`` or 0.5 (the tail is down to 1 % there). A cell is
 *visible* from a camera when ``epsilon >= -band`` (in front of or on the measured surface,
@@ -395,7 +395,7 @@ class OccupancyGrid:
 
     spec : GridSpec (see :func:`spec_from_cameras`)
     cameras : Camera or sequence of Camera (unique names)
-    noise_models : None or dict camera name -> noise model name of :mod:`occupose.synth.noise`
+    noise_models : None or dict camera name -> noise model name of :mod:`occupose.sensors`
         (``"structured_light"``, ``"tof"``, ``"none"``): sets each camera's depth tolerance.
         Default: the camera's sensor preset's model when its intrinsics match a preset,
         else DEFAULT_NOISE_MODEL.
