@@ -95,8 +95,9 @@ that is not observed still ends up E after one prediction (``0.99 * 0.4 < 0.01 *
 * 0.6``: unknown space counts as empty, not as an obstacle). A person present at frame 0 is
 O where they stand at first and M wherever they move to: a walking person within the time
 their body takes to clear its first position (about 10 frames at 1.3 m/s), a person who
-stands still only once they move (in ``no_occlusion``, where the person stands and waves
-for the first 6 s, only the waving arm is M until they start walking). Putting most mass on E instead (``initial=(q, 0, 1 - q)``
+stands still only once they move (only a waving arm is M until they start walking; the
+built-in scenes, ``no_occlusion`` among them, start with their people already walking for
+this reason). Putting most mass on E instead (``initial=(q, 0, 1 - q)``
 with ``q`` small) makes everything seen occupied M for the first ``-ln(r_0) / ln(a)``
 frames: the person then, but the whole room too, and from that frame on both choices give
 the same states.
