@@ -354,7 +354,7 @@ class SensorSpec:
 
     width, height : int, pixels; fx, fy, cx, cy : float, pixels;
     near, far : float, metres, nominal measuring range;
-    noise : str, name of the sensor noise model in occupose.synth.noise ("structured_light" for
+    noise : str, name of the sensor noise model in occupose.sensors ("structured_light" for
         Kinect v1 and, for want of a stereo model, the active-stereo RealSense; "tof").
     """
 

@@ -13,10 +13,11 @@ from ``occupose.testing.capsules_from_primitives``). For a body model's predicte
     hold = cells_near_capsules(grid.spec, a[0], b[0], model.capsule_radii)
     grid.update(depths, hold=hold)                           # several people: OR their masks
 
-Measured on the synthetic scenes with the true bodies held (benchmarks/bench_blobs.py):
-pixel assignment over all 300 frames of ``top_view_two_people`` 99.6 % (72 % without the
-hold, where the still bodies fade); holding the previous frame's blob cells dilated by
-0.1 m instead gave 90.6 % with identity swaps.
+Measured on the synthetic scenes with the true bodies held (benchmarks/bench_blobs.py,
+benchmarks/results/latest.md): pixel assignment over all 300 frames of
+``top_view_two_people`` 99.66 % (without the hold, where the still bodies fade, 75.41 % on
+the 205 frames that still have pixels assigned); holding the previous frame's blob cells
+dilated by 0.1 m instead gave 90.64 % with 24 identity swaps.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ edges blurred by the sensor's depth noise::
 
 with ``h`` half the cell's extent along the optical axis, ``cell / 2 * (|r_x| + |r_y| + |r_z|)``
 for the camera's viewing direction ``r`` in world axes, and ``w = tail_width * s`` where ``s``
-is the sensor's random depth error at that distance (:func:`occupose.synth.noise.depth_std`
+is the sensor's random depth error at that distance (:func:`occupose.sensors.depth_std`
 of the camera's noise model; ``tail_width`` 2 by default). The tails stop at ``band = h + 3 w``,
 beyond which f is exactly ``p_free`` or 0.5 (the tail is down to 1 % there). A cell is
 *visible* from a camera when ``epsilon >= -band`` (in front of or on the measured surface,
@@ -95,8 +95,9 @@ that is not observed still ends up E after one prediction (``0.99 * 0.4 < 0.01 *
 * 0.6``: unknown space counts as empty, not as an obstacle). A person present at frame 0 is
 O where they stand at first and M wherever they move to: a walking person within the time
 their body takes to clear its first position (about 10 frames at 1.3 m/s), a person who
-stands still only once they move (in ``no_occlusion``, where the person stands and waves
-for the first 6 s, only the waving arm is M until they start walking). Putting most mass on E instead (``initial=(q, 0, 1 - q)``
+stands still only once they move (only a waving arm is M until they start walking; the
+built-in scenes, ``no_occlusion`` among them, start with their people already walking for
+this reason). Putting most mass on E instead (``initial=(q, 0, 1 - q)``
 with ``q`` small) makes everything seen occupied M for the first ``-ln(r_0) / ln(a)``
 frames: the person then, but the whole room too, and from that frame on both choices give
 the same states.
@@ -395,7 +396,7 @@ class OccupancyGrid:
 
     spec : GridSpec (see :func:`spec_from_cameras`)
     cameras : Camera or sequence of Camera (unique names)
-    noise_models : None or dict camera name -> noise model name of :mod:`occupose.synth.noise`
+    noise_models : None or dict camera name -> noise model name of :mod:`occupose.sensors`
         (``"structured_light"``, ``"tof"``, ``"none"``): sets each camera's depth tolerance.
         Default: the camera's sensor preset's model when its intrinsics match a preset,
         else DEFAULT_NOISE_MODEL.

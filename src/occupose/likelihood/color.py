@@ -51,7 +51,7 @@ class ColorLikelihood:
 
     observation : Observation; views without a colour image are skipped
     scale : nats; bins : cells per RGB channel
-    margin : metres, and noise : sensor model name (:func:`occupose.synth.noise.depth_std`),
+    margin : metres, and noise : sensor model name (:func:`occupose.sensors.depth_std`),
         the tolerance before a sample counts as hidden
     samples_along, samples_around : surface samples per capsule (angles -45..45 degrees)
     reference : (K, bins^3) histograms (rows are normalised here; an all-zero row means

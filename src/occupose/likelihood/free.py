@@ -10,7 +10,7 @@ measurement (depth 0) or outside the image costs nothing.
 
 "Clearly behind": measured depth d > z + margin(d) with margin(d) = ``margin`` + 3 sigma(d),
 sigma the random depth error of the sensor ``noise`` model
-(:func:`occupose.synth.noise.depth_std`). A sample's penalty ramps linearly from 0 to 1
+(:func:`occupose.sensors.depth_std`). A sample's penalty ramps linearly from 0 to 1
 over ``ramp`` metres beyond that, and::
 
     log L[p, k] = -weight * (mean penalty over part k's samples in all views)
@@ -45,7 +45,7 @@ class FreeSpaceLikelihood:
     observation : Observation (its views' depth images are read)
     weight : nats for a part wholly in seen-empty space
     margin, ramp : metres (see the module docstring)
-    noise : sensor noise model name of :func:`occupose.synth.noise.depth_std`
+    noise : sensor noise model name of :func:`occupose.sensors.depth_std`
         ("structured_light", "tof" or "none")
     samples_along, samples_around : samples per capsule along and about its axis; the
         angles about it span -45..45 degrees from the direction facing the camera.
