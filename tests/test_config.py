@@ -49,6 +49,7 @@ def test_a_toml_file_becomes_a_config_that_summary_json_holds_whole(tmp_path):
     assert config.occlusion.enabled is False and config.start.look_back_s == 0.0  # apf's, and the file's
     summary = json.loads(json.dumps(summary_of(TrackingResult({}, config=config, seed=3, model="full"), "rec", "apf")))
     assert summary["method"] == "apf" and summary["seed"] == 3 and summary["model"] == "full"
+    assert summary["overlap"] is False
     assert TrackerConfig.from_dict(summary["config"]) == config
     assert TrackerConfig.from_dict(summary["config"] | {"method": "ps"}) == config  # every field is given
 

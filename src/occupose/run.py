@@ -34,6 +34,8 @@ class TrackingResult:
     fps : frames per second of tracking, the first frame (start-up) excluded
     num_frames : frames tracked
     config : the settings of the run; seed : its seed; model : the body model it used
+    overlap : whether the grid ran a frame ahead on a second thread (its hold mask then
+        comes from the bodies one frame older, so the tracks may differ)
     """
 
     tracks: dict[int, tuple[np.ndarray, np.ndarray]]
@@ -43,6 +45,7 @@ class TrackingResult:
     config: TrackerConfig = field(default_factory=TrackerConfig)
     seed: int = 0
     model: str = ""
+    overlap: bool = False
 
 
 def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: Callable[[int], None] | None = None,
@@ -85,7 +88,7 @@ def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: 
     tracker.close()
     fps = (num_frames - 1) / total if num_frames > 1 and total > 0 else 0.0
     return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, dict(seconds, total=total,
-                          startup=startup), fps, num_frames, tracker.config, tracker.seed, tracker.model_name)
+                          startup=startup), fps, num_frames, tracker.config, tracker.seed, tracker.model_name, overlap)
 
 
 def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: int = 0,
@@ -113,10 +116,11 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:
     """The ``summary.json`` of a run: the recording, the method's name (if it was run as
-    one), seed, body model, the whole resolved config, frames, people, seconds per stage
-    and frames/s (start-up excluded)."""
+    one: the base of its config), seed, body model, the whole resolved config, whether the
+    grid ran ahead on a thread, frames, people, seconds per stage and frames/s (start-up
+    excluded)."""
     return {"recording": str(recording_path), "method": method, "seed": result.seed, "model": result.model,
-            "config": result.config.to_dict(), "frames": result.num_frames, "people": len(result.tracks),
+            "config": result.config.to_dict(), "overlap": result.overlap, "frames": result.num_frames, "people": len(result.tracks),
             "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
 
 
