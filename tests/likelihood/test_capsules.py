@@ -54,7 +54,7 @@ def test_blocked_points_match_reference(rng):
 def test_select_partitions_around_the_kth_with_ties(rng):
     """The quickselect of the median splits against the order statistics, on keys with
     many ties (only 4 distinct values) and on distinct ones, for several k."""
-    from occupose.likelihood._kernels import _select
+    from occupose.likelihood._distance_kernels import _select
 
     for points in (rng.integers(0, 4, size=(301, 3)).astype(np.float64), rng.normal(size=(301, 3))):
         for lo, hi, kth in ((0, 301, 150), (17, 280, 20), (17, 280, 279), (100, 102, 101)):

@@ -45,7 +45,7 @@ def test_point_distances_match_brute_force(rng, capsule_distances):
 def test_block_pruning_is_exact_on_a_body(front, rng, model_capsules):
     """The blocked kernel (capsules skipped per block of nearby points) against one block
     holding every point (every capsule visited), on a person's points and diffused poses."""
-    from occupose.likelihood import _kernels
+    from occupose.likelihood import _distance_kernels
     from occupose.likelihood._capsules import blocked_points
 
     obs, pose = front
@@ -55,7 +55,7 @@ def test_block_pruning_is_exact_on_a_body(front, rng, model_capsules):
     whole = blocked_points(obs.points, block_size=len(obs.points))
     want_distance = np.empty((20, len(whole.px)), np.float32)
     want_capsule = np.empty((20, len(whole.px)), np.int32)
-    _kernels.nearest_capsules(a, b, radii, *whole.kernel_args, want_distance, want_capsule)
+    _distance_kernels.nearest_capsules(a, b, radii, *whole.kernel_args, want_distance, want_capsule)
     np.testing.assert_allclose(distance, want_distance[:, whole.position], atol=1e-6)
     assert np.mean(capsule == want_capsule[:, whole.position]) > 0.999
 

@@ -31,7 +31,7 @@ def test_camera_samples_of_a_capsule_on_the_cameras_axis():
     turns from a world axis instead; they must still lie on the capsule, the end samples
     on the end spheres' points nearest the camera, and a limb in seen-empty space cost
     its whole weight."""
-    from occupose.likelihood import _kernels
+    from occupose.likelihood import _sample_kernels
     from occupose.likelihood._samples import camera_arrays, sample_pattern
 
     camera = Camera("top", 80, 60, 60.0, 60.0, 39.5, 29.5, world_from_camera=look_at((0, 0, 3.0), (0, 0, 0)))
@@ -40,7 +40,7 @@ def test_camera_samples_of_a_capsule_on_the_cameras_axis():
     along, cos_around, sin_around, count = sample_pattern(3, 4)
     rotation, shift = camera_arrays(camera)
     samples = np.empty((3, count))
-    _kernels._camera_samples(a, b, radii, 0, 0, rotation, shift, along, cos_around, sin_around, samples)
+    _sample_kernels._camera_samples(a, b, radii, 0, 0, rotation, shift, along, cos_around, sin_around, samples)
     world = (samples.T - shift) @ rotation  # camera -> world (rotation is orthonormal)
     assert np.isfinite(world).all()
     np.testing.assert_allclose(world[:2], [[0, 0, 1.06], [0, 0, 0.54]], atol=1e-9)  # nearest the camera

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _distance_kernels
 from occupose.likelihood._capsules import blocked_points, check_capsules, check_positive
 from occupose.likelihood.observation import Observation
 
@@ -50,7 +50,7 @@ def point_distances(a, b, radii, points, *, sort: bool = True) -> tuple[np.ndarr
         blocks = blocked_points(points, sort=sort)
     blocked_distance = np.empty((a.shape[0], len(blocks.px)), np.float32)
     blocked_capsule = np.empty((a.shape[0], len(blocks.px)), np.int32)
-    _kernels.nearest_capsules(a, b, radii, *blocks.kernel_args, blocked_distance, blocked_capsule)
+    _distance_kernels.nearest_capsules(a, b, radii, *blocks.kernel_args, blocked_distance, blocked_capsule)
     return blocked_distance[:, blocks.position], blocked_capsule[:, blocks.position]
 
 
@@ -78,6 +78,7 @@ class PointsLikelihood:
     def evaluate_checked(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         out = np.zeros((a.shape[0], num_parts))
-        _kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, self._blocks.weight, out)
+        _distance_kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, self._blocks.weight,
+                                              out)
         out *= -1.0 / (self.num_points * self.scale)
         return out
