@@ -21,7 +21,7 @@ from occupose.likelihood.observation import Observation
 #: one nat (the paper's exp(-d) with d in centimetres). Every term's default is set so
 #: that, alone, it keeps about half of the particles effective in one calibration: the
 #: ``full`` model at the fitted true pose of a synthetic frame (a person facing a Kinect v1
-#: 2.5 m away, with its depth noise, as in tests/test_likelihood.py) and 200 particles
+#: 2.5 m away, with its depth noise, as ``front`` in tests/likelihood/conftest.py) and 200 particles
 #: diffused by 0.1 rad / 3 cm per DOF. There the mean distance is 1.9 cm at the true pose
 #: and the effective sample size 104 of 200 (scale 0.05 m: 190, nearly flat; 0.005 m: 46).
 #: Annealed filters rescale it anyway.
