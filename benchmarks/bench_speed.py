@@ -21,7 +21,8 @@ from occupose.evaluation.pixels import pixel_assignment_accuracy
 from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.testing import persons_from_tracks
-from occupose.tracker import Tracker, track_frames
+from occupose.run import track_frames
+from occupose.tracker import Tracker
 
 TITLE = "Tracker speed: frames/s of `occupose track` (ours), start-up excluded, and ms per frame per stage"
 

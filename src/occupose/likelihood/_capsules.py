@@ -6,7 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _distance_kernels
 
 
 def check_capsules(a, b, radii, capsule_part, num_parts):
@@ -50,7 +50,7 @@ def check_positive(value, what: str) -> float:
 
 #: Metres added to the blocks' radii to cover float32 rounding of the point distances.
 BOUND_SLACK = 1e-5
-#: Points per block of the points kernels (see occupose.likelihood._kernels._nearest_in_block).
+#: Points per block of the points kernels (see occupose.likelihood._distance_kernels._nearest_in_block).
 BLOCK_SIZE = 64
 #: Blocks are padded to a multiple of this many points (copies of their last point, weight
 #: 0), so that the vectorised point loop has no scalar remainder (4 x 8 float32 lanes).
@@ -104,8 +104,8 @@ def blocked_points(points: np.ndarray, block_size: int = BLOCK_SIZE, pad: int = 
                            empty, np.zeros(0, np.int64))
     if sort:
         order = np.empty(len(points), np.int64)
-        leaf_start = _kernels.block_order(points, int(block_size), order)
+        leaf_start = _distance_kernels.block_order(points, int(block_size), order)
     else:
         order = np.arange(len(points))
         leaf_start = np.append(np.arange(0, len(points), int(block_size)), len(points))
-    return PointBlocks(*_kernels.pack_blocks(points, order, leaf_start, int(pad), BOUND_SLACK))
+    return PointBlocks(*_distance_kernels.pack_blocks(points, order, leaf_start, int(pad), BOUND_SLACK))

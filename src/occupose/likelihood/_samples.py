@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _sample_kernels
 from occupose.sensors import depth_std_coefficients
 
 #: Angles of the samples about a capsule's axis, either side of the camera-facing direction,
@@ -14,7 +14,7 @@ SAMPLE_SPAN_DEGREES = 45.0
 
 def sample_pattern(samples_along, samples_around):
     """Check the sample counts; return along (T,), cos_around (A,), sin_around (A,) float64
-    (see occupose.likelihood._kernels._camera_samples) and the samples per capsule, 2 + T A."""
+    (see occupose.likelihood._sample_kernels._camera_samples) and the samples per capsule, 2 + T A."""
     for name, count in (("samples_along", samples_along), ("samples_around", samples_around)):
         if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
             raise ValueError(f"{name} must be a positive integer, got {count!r}")
@@ -38,7 +38,7 @@ def offset_depths(depth: np.ndarray, margin: float, noise: str, sign: float) -> 
     coefficients[0] += margin
     depth = np.ascontiguousarray(depth, dtype=np.float32)
     out = np.empty(depth.shape, np.float32)
-    _kernels.offset_depths(depth, *(float(sign) * coefficients), out)
+    _sample_kernels.offset_depths(depth, *(float(sign) * coefficients), out)
     return out
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _sample_kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
 from occupose.likelihood._samples import camera_arrays, offset_depths, sample_pattern
 from occupose.likelihood.observation import Observation
@@ -91,8 +91,8 @@ class ColorLikelihood:
     def _histograms(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         counts = np.zeros((a.shape[0], num_parts, self.num_bins))
         for rotation, shift, cam, hidden, cells in self._views:
-            _kernels.color_counts(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
-                                  hidden, cells, self._along, self._cos, self._sin, counts)
+            _sample_kernels.color_counts(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
+                                         hidden, cells, self._along, self._cos, self._sin, counts)
         total = counts.sum(axis=2, keepdims=True)
         return np.divide(counts, total, out=counts, where=total > 0)
 

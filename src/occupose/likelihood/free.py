@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _sample_kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
 from occupose.likelihood._samples import camera_arrays, offset_depths, sample_pattern
 from occupose.likelihood.observation import Observation
@@ -75,8 +75,8 @@ class FreeSpaceLikelihood:
         """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         out = np.zeros((a.shape[0], num_parts))
         for rotation, shift, cam, free in self._views:
-            _kernels.free_space_penalties(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
-                                          free, self._along, self._cos, self._sin, self.ramp, out)
+            _sample_kernels.free_space_penalties(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx,
+                                                 cam.cy, free, self._along, self._cos, self._sin, self.ramp, out)
         samples = np.bincount(capsule_part, minlength=num_parts) * self.samples_per_capsule * len(self._views)
         out *= -self.weight / np.maximum(samples, 1)
         return out

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _distance_kernels
 from occupose.likelihood._capsules import blocked_points, check_capsules, check_positive
 from occupose.likelihood.observation import Observation
 
@@ -21,7 +21,7 @@ from occupose.likelihood.observation import Observation
 #: one nat (the paper's exp(-d) with d in centimetres). Every term's default is set so
 #: that, alone, it keeps about half of the particles effective in one calibration: the
 #: ``full`` model at the fitted true pose of a synthetic frame (a person facing a Kinect v1
-#: 2.5 m away, with its depth noise, as in tests/test_likelihood.py) and 200 particles
+#: 2.5 m away, with its depth noise, as ``front`` in tests/likelihood/conftest.py) and 200 particles
 #: diffused by 0.1 rad / 3 cm per DOF. There the mean distance is 1.9 cm at the true pose
 #: and the effective sample size 104 of 200 (scale 0.05 m: 190, nearly flat; 0.005 m: 46).
 #: Annealed filters rescale it anyway.
@@ -50,7 +50,7 @@ def point_distances(a, b, radii, points, *, sort: bool = True) -> tuple[np.ndarr
         blocks = blocked_points(points, sort=sort)
     blocked_distance = np.empty((a.shape[0], len(blocks.px)), np.float32)
     blocked_capsule = np.empty((a.shape[0], len(blocks.px)), np.int32)
-    _kernels.nearest_capsules(a, b, radii, *blocks.kernel_args, blocked_distance, blocked_capsule)
+    _distance_kernels.nearest_capsules(a, b, radii, *blocks.kernel_args, blocked_distance, blocked_capsule)
     return blocked_distance[:, blocks.position], blocked_capsule[:, blocks.position]
 
 
@@ -78,6 +78,7 @@ class PointsLikelihood:
     def evaluate_checked(self, a, b, radii, capsule_part, num_parts) -> np.ndarray:
         """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         out = np.zeros((a.shape[0], num_parts))
-        _kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, self._blocks.weight, out)
+        _distance_kernels.point_distance_sums(a, b, radii, capsule_part, *self._blocks.kernel_args, self._blocks.weight,
+                                              out)
         out *= -1.0 / (self.num_points * self.scale)
         return out

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from occupose.likelihood import _kernels
+from occupose.likelihood import _distance_kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
 from occupose.likelihood._samples import camera_arrays
 from occupose.likelihood.observation import Observation
@@ -85,8 +85,8 @@ class RenderLikelihood:
         """:meth:`evaluate` on arguments that passed ``check_capsules``."""
         out = np.zeros((a.shape[0], num_parts))
         for rotation, shift, cam, u0, v0, observed, index, x, y, z in self._views:
-            _kernels.render_sigmas(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
-                                   u0, v0, self.stride, observed, index, x, y, z, self.truncation,
-                                   min(a.shape[0], 4 * numba.get_num_threads()), out)
+            _distance_kernels.render_sigmas(a, b, radii, capsule_part, rotation, shift, cam.fx, cam.fy, cam.cx, cam.cy,
+                                            u0, v0, self.stride, observed, index, x, y, z, self.truncation,
+                                            min(a.shape[0], 4 * numba.get_num_threads()), out)
         out *= -self.scale / max(self.num_observed, 1)
         return out
