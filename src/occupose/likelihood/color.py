@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from occupose.config import LikelihoodConfig
 from occupose.likelihood import _sample_kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
 from occupose.likelihood._samples import camera_arrays, offset_depths, sample_pattern
@@ -28,12 +29,12 @@ from occupose.likelihood.observation import Observation
 #: Calibrated as the points scale (occupose.likelihood.points.POINTS_SCALE), with the
 #: reference taken from a slightly different pose of the frame before: an effective sample
 #: size of 88 of 200 (scale 2: 38).
-COLOR_SCALE = 1.0
+COLOR_SCALE = LikelihoodConfig.color_scale
 #: Default histogram cells per RGB channel (4 -> 64 cells; 8 -> 512 is too sparse for the
 #: few dozen samples of a limb).
-COLOR_BINS = 4
+COLOR_BINS = LikelihoodConfig.color_bins
 #: Default margin beyond 3 sigma of sensor noise, metres, before a sample counts as hidden.
-COLOR_MARGIN = 0.05
+COLOR_MARGIN = LikelihoodConfig.color_margin
 
 
 def color_cells(color: np.ndarray, bins: int = COLOR_BINS) -> np.ndarray:

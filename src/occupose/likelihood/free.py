@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from occupose.config import LikelihoodConfig
 from occupose.likelihood import _sample_kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
 from occupose.likelihood._samples import camera_arrays, offset_depths, sample_pattern
@@ -31,12 +32,12 @@ from occupose.likelihood.observation import Observation
 #: scale (occupose.likelihood.points.POINTS_SCALE): the term is -0.03 at the true pose and
 #: leaves an effective sample size of 86 of 200 alone, 42 together with ``points``
 #: (weight 0.5: 144 and 71).
-FREE_WEIGHT = 1.0
+FREE_WEIGHT = LikelihoodConfig.free_weight
 #: Default margin beyond 3 sigma of sensor noise, metres: the capsule model's radius error
 #: (a few cm) plus the surface samples' offset from the true surface.
-FREE_MARGIN = 0.03
+FREE_MARGIN = LikelihoodConfig.free_margin
 #: Default ramp, metres, over which a sample's penalty grows from 0 to 1.
-FREE_RAMP = 0.05
+FREE_RAMP = LikelihoodConfig.free_ramp
 
 
 class FreeSpaceLikelihood:
@@ -52,7 +53,7 @@ class FreeSpaceLikelihood:
     """
 
     def __init__(self, observation: Observation, *, weight: float = FREE_WEIGHT, margin: float = FREE_MARGIN,
-                 ramp: float = FREE_RAMP, noise: str = "structured_light", samples_along: int = 5,
+                 ramp: float = FREE_RAMP, noise: str = LikelihoodConfig.free_noise, samples_along: int = 5,
                  samples_around: int = 5):
         if not isinstance(observation, Observation):
             raise ValueError(f"observation must be an Observation, got {type(observation).__name__}")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from occupose.config import LikelihoodConfig
 from occupose.likelihood import _distance_kernels
 from occupose.likelihood._capsules import blocked_points, check_capsules, check_positive
 from occupose.likelihood.observation import Observation
@@ -25,7 +26,7 @@ from occupose.likelihood.observation import Observation
 #: diffused by 0.1 rad / 3 cm per DOF. There the mean distance is 1.9 cm at the true pose
 #: and the effective sample size 104 of 200 (scale 0.05 m: 190, nearly flat; 0.005 m: 46).
 #: Annealed filters rescale it anyway.
-POINTS_SCALE = 0.01
+POINTS_SCALE = LikelihoodConfig.points_scale
 
 
 def point_distances(a, b, radii, points, *, sort: bool = True) -> tuple[np.ndarray, np.ndarray]:

@@ -25,6 +25,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from occupose.config import LikelihoodConfig
 from occupose.likelihood import _distance_kernels
 from occupose.likelihood._capsules import check_capsules, check_positive
 from occupose.likelihood._samples import camera_arrays
@@ -34,11 +35,11 @@ from occupose.likelihood.observation import Observation
 #: of the silhouette (about one limb) and covers as much elsewhere costs 5 x 0.2 = 1 nat.
 #: Calibrated as the points scale (occupose.likelihood.points.POINTS_SCALE): an effective
 #: sample size of 123 of 200 (scale 10: 40).
-RENDER_SCALE = 5.0
+RENDER_SCALE = LikelihoodConfig.render_scale
 #: The paper's truncation D, metres.
-RENDER_TRUNCATION = 0.1
+RENDER_TRUNCATION = LikelihoodConfig.render_truncation
 #: Default grid stride, pixels.
-RENDER_STRIDE = 4
+RENDER_STRIDE = LikelihoodConfig.render_stride
 
 
 class RenderLikelihood:
