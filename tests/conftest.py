@@ -54,3 +54,18 @@ def tracking(walk):
         out = tracker.update(f.depth)
     assert list(out.estimates) == [1]
     return tracker, rendered[11].depth
+
+
+@pytest.fixture
+def standing_skeleton():
+    """(15, 3) a standing canonical skeleton facing +y (its left side at smaller x), metres, z up."""
+    from occupose.joints import JOINTS
+
+    p = {
+        "head": (0, 0, 1.60), "neck": (0, 0, 1.45), "pelvis": (0, 0, 0.95),
+        "left_shoulder": (-0.18, 0, 1.42), "left_elbow": (-0.20, 0, 1.12), "left_wrist": (-0.21, 0, 0.86),
+        "right_shoulder": (0.18, 0, 1.42), "right_elbow": (0.20, 0, 1.12), "right_wrist": (0.21, 0, 0.86),
+        "left_hip": (-0.09, 0, 0.95), "left_knee": (-0.10, 0, 0.52), "left_ankle": (-0.10, 0, 0.08),
+        "right_hip": (0.09, 0, 0.95), "right_knee": (0.10, 0, 0.52), "right_ankle": (0.10, 0, 0.08),
+    }
+    return np.array([p[name] for name in JOINTS], dtype=np.float64)

@@ -58,3 +58,15 @@ def bool_array(value: Any, what: str, shape: tuple[int, ...]) -> np.ndarray:
     if array.shape != shape:
         raise ValueError(f"{what} must have shape {shape}, got {array.shape}")
     return array
+
+
+def joints_array(joints: Any, what: str = "joints", min_ndim: int = 2) -> np.ndarray:
+    """``joints`` as float64 of shape (..., 15, 3) (canonical joints) with at least
+    ``min_ndim`` dimensions."""
+    from occupose.joints import NUM_JOINTS
+
+    joints = np.asarray(joints, dtype=np.float64)
+    if joints.ndim < min_ndim or joints.shape[-2:] != (NUM_JOINTS, 3):
+        raise ValueError(f"{what} must have shape (..., {NUM_JOINTS}, 3) with at least {min_ndim} "
+                         f"dimensions, got {joints.shape}")
+    return joints

@@ -16,20 +16,8 @@ from occupose.synth.retarget import facing_from_joints
 # Canonical joints and measurements on synthetic arrays
 
 
-def _standing(facing_y=True):
-    """A standing canonical skeleton facing +y (left side at smaller x), metres, z up."""
-    p = {
-        "head": (0, 0, 1.60), "neck": (0, 0, 1.45), "pelvis": (0, 0, 0.95),
-        "left_shoulder": (-0.18, 0, 1.42), "left_elbow": (-0.20, 0, 1.12), "left_wrist": (-0.21, 0, 0.86),
-        "right_shoulder": (0.18, 0, 1.42), "right_elbow": (0.20, 0, 1.12), "right_wrist": (0.21, 0, 0.86),
-        "left_hip": (-0.09, 0, 0.95), "left_knee": (-0.10, 0, 0.52), "left_ankle": (-0.10, 0, 0.08),
-        "right_hip": (0.09, 0, 0.95), "right_knee": (0.10, 0, 0.52), "right_ankle": (0.10, 0, 0.08),
-    }
-    return np.array([p[name] for name in JOINTS], dtype=np.float64)
-
-
-def test_bone_lengths_and_standing_height():
-    body = _standing()
+def test_bone_lengths_and_standing_height(standing_skeleton):
+    body = standing_skeleton
     lengths = mc.bone_lengths(body)
     assert lengths.shape == (len(BONES),)
     assert lengths[BONES.index((J["left_knee"], J["left_ankle"]))] == pytest.approx(0.44)
@@ -90,8 +78,6 @@ def test_list_and_find_clips_in_a_data_folder(tmp_path, monkeypatch):
 # ---------------------------------------------------------------------------------------
 # The shared real clips
 
-_ARM, _FOREARM = (J["left_shoulder"], J["left_elbow"]), (J["left_elbow"], J["left_wrist"])
-_THIGH, _SHIN = (J["left_hip"], J["left_knee"]), (J["left_knee"], J["left_ankle"])
 
 
 def _check_body(joints, forearm=(0.20, 0.32), upper_arm=(0.25, 0.35), height=(1.4, 2.0)):

@@ -6,20 +6,8 @@ import numpy as np
 import pytest
 
 from occupose.io.mocap import ANKLE_HEIGHT, bone_lengths
-from occupose.joints import JOINT_INDEX as J, JOINTS
+from occupose.joints import JOINT_INDEX as J
 from occupose.synth import retarget as rt
-
-
-def _standing(facing_y=True):
-    """A standing canonical skeleton facing +y (left side at smaller x), metres, z up."""
-    p = {
-        "head": (0, 0, 1.60), "neck": (0, 0, 1.45), "pelvis": (0, 0, 0.95),
-        "left_shoulder": (-0.18, 0, 1.42), "left_elbow": (-0.20, 0, 1.12), "left_wrist": (-0.21, 0, 0.86),
-        "right_shoulder": (0.18, 0, 1.42), "right_elbow": (0.20, 0, 1.12), "right_wrist": (0.21, 0, 0.86),
-        "left_hip": (-0.09, 0, 0.95), "left_knee": (-0.10, 0, 0.52), "left_ankle": (-0.10, 0, 0.08),
-        "right_hip": (0.09, 0, 0.95), "right_knee": (0.10, 0, 0.52), "right_ankle": (0.10, 0, 0.08),
-    }
-    return np.array([p[name] for name in JOINTS], dtype=np.float64)
 
 
 def _rotz(points, angle):
@@ -27,8 +15,8 @@ def _rotz(points, angle):
     return points @ np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]).T
 
 
-def test_facing_from_joints_follows_rotation_about_z():
-    body = _standing()
+def test_facing_from_joints_follows_rotation_about_z(standing_skeleton):
+    body = standing_skeleton
     assert rt.facing_from_joints(body) == pytest.approx(math.pi / 2)
     angles = np.array([0.3, -2.0, 3.0])
     bodies = np.stack([_rotz(body, a) for a in angles])
@@ -36,8 +24,8 @@ def test_facing_from_joints_follows_rotation_about_z():
     np.testing.assert_allclose(rt.facing_from_joints(bodies), expected, atol=1e-12)
 
 
-def test_place_puts_pelvis_heading_and_ankles(rng):
-    base = _rotz(_standing(), 1.1) + [4.0, -3.0, 0.37]
+def test_place_puts_pelvis_heading_and_ankles(rng, standing_skeleton):
+    base = _rotz(standing_skeleton, 1.1) + [4.0, -3.0, 0.37]
     walk = np.linspace(0, 1, 45)[:, None, None] * [0.5, 0.2, 0.0]
     sway = np.zeros((45, 15, 3))
     sway[:, J["left_ankle"], 2] = 0.05 * np.sin(np.arange(45) / 3.0) ** 2

@@ -19,6 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from occupose._validate import joints_array
 from occupose.joints import BONES, JOINT_INDEX, NUM_JOINTS
 from occupose.paths import mocap_dir
 
@@ -174,17 +175,9 @@ def canonical_from_clip(clip: Clip) -> np.ndarray:
 # Operations on canonical joints
 
 
-def _check_joints(joints, name: str = "joints", min_ndim: int = 2) -> np.ndarray:
-    joints = np.asarray(joints, dtype=np.float64)
-    if joints.ndim < min_ndim or joints.shape[-2:] != (NUM_JOINTS, 3):
-        raise ValueError(f"{name} must have shape (..., {NUM_JOINTS}, 3) with at least {min_ndim} "
-                         f"dimensions, got {joints.shape}")
-    return joints
-
-
 def bone_lengths(joints) -> np.ndarray:
     """Lengths of :data:`occupose.joints.BONES`: joints (..., 15, 3) -> (..., len(BONES)), metres."""
-    joints = _check_joints(joints, min_ndim=2)
+    joints = joints_array(joints, min_ndim=2)
     a = np.array([b[0] for b in BONES])
     b = np.array([b[1] for b in BONES])
     return np.linalg.norm(joints[..., b, :] - joints[..., a, :], axis=-1)
@@ -196,7 +189,7 @@ def standing_height(joints) -> np.ndarray:
     Top of the head (head centre + :data:`HEAD_TOP` 0.10 m) minus the floor under the
     lower ankle (its z minus :data:`ANKLE_HEIGHT` 0.08 m). Meaningful for upright frames.
     """
-    joints = _check_joints(joints, min_ndim=2)
+    joints = joints_array(joints, min_ndim=2)
     ankles = np.minimum(joints[..., JOINT_INDEX["left_ankle"], 2], joints[..., JOINT_INDEX["right_ankle"], 2])
     return joints[..., JOINT_INDEX["head"], 2] + HEAD_TOP - (ankles - ANKLE_HEIGHT)
 

@@ -13,16 +13,9 @@ import math
 
 import numpy as np
 
+from occupose._validate import joints_array
 from occupose.io.mocap import ANKLE_HEIGHT
-from occupose.joints import JOINT_INDEX, NUM_JOINTS
-
-
-def _check_joints(joints, name: str = "joints", min_ndim: int = 2) -> np.ndarray:
-    joints = np.asarray(joints, dtype=np.float64)
-    if joints.ndim < min_ndim or joints.shape[-2:] != (NUM_JOINTS, 3):
-        raise ValueError(f"{name} must have shape (..., {NUM_JOINTS}, 3) with at least {min_ndim} "
-                         f"dimensions, got {joints.shape}")
-    return joints
+from occupose.joints import JOINT_INDEX
 
 
 def resample(joints, fps_in: float, fps_out: float) -> np.ndarray:
@@ -52,7 +45,7 @@ def facing_from_joints(joints) -> np.ndarray:
     joints : (..., 15, 3) canonical joints, world frame, z up. Facing is
     (left_hip - right_hip) x z, projected on the floor. Returns (...,).
     """
-    joints = _check_joints(joints, min_ndim=2)
+    joints = joints_array(joints, min_ndim=2)
     left = joints[..., JOINT_INDEX["left_hip"], :] - joints[..., JOINT_INDEX["right_hip"], :]
     # (lx, ly, lz) x (0, 0, 1) = (ly, -lx, 0)
     return np.arctan2(-left[..., 0], left[..., 1])
@@ -68,7 +61,7 @@ def place(joints, start_xy=(0.0, 0.0), heading: float = 0.0, fps: float = 30.0,
     :func:`facing_from_joints`), then shifts z so the lowest ankle over the first second
     is ``ankle_height`` metres above the floor (z = 0). Returns (T, 15, 3).
     """
-    joints = _check_joints(joints, min_ndim=3)
+    joints = joints_array(joints, min_ndim=3)
     if joints.ndim != 3 or joints.shape[0] < 1:
         raise ValueError(f"joints must have shape (T, 15, 3) with T >= 1, got {joints.shape}")
     if not fps > 0:
