@@ -524,7 +524,7 @@ class OccupancyGrid:
             frames (about 1e-26 in a cell seen through for 20 frames before a person stepped
             in) makes it O: with psi = 0 alone, a box walking in from the first frame and
             held all along turned static 120 frames after it stopped instead of 77
-            (the construction of tests/test_grid.py). Moving the share keeps it at 0. Held cells in O or E step as with psi = 0 only, so the hold takes nothing from
+            (the construction of tests/grid/test_hold.py). Moving the share keeps it at 0. Held cells in O or E step as with psi = 0 only, so the hold takes nothing from
             the background (the floor under the feet, the seat of a chair stay O) and makes
             no cell occupied. A bool mask is what the kernel reads cheapest: one byte per
             cell in its parallel loop.

@@ -1,9 +1,10 @@
 """Which body parts are hidden by the scene, and what the filter may estimate (paper III-D).
 
 Each body part is approximated by ``n`` spheres along the axes of its capsules. At every
-frame the previous estimate, moved to its blob's new centre of mass, is tested against the
-occupancy grid's visibility: a part with more than half of its spheres in HIDDEN cells is
-hidden. Every part runs the two-state machine of the paper's Fig. 7:
+frame the previous estimate, moved to its blob's new centre of mass, is tested for what
+hides it (the paper tests the occupancy grid's visibility; the tracker tests the depth
+images, :func:`hidden_parts_in_views`, below): a part with more than half of its spheres
+hidden is hidden. Every part runs the two-state machine of the paper's Fig. 7:
 
 - VISIBLE: its configuration (its DOFs, relative to its parent) is saved in a memory M;
   it becomes HIDDEN when its current configuration tests hidden;
