@@ -101,6 +101,28 @@ def persons_from_tracks(assigned: Sequence[np.ndarray], truth: Sequence[np.ndarr
     return {int(track_of[order][i]): int(person_of[order][i]) for i in first}
 
 
+
+def mark_column(mask: np.ndarray, spec: GridSpec, x: float, y: float, *, width: float = 0.3, depth: float = 0.1,
+                z_low: float = 0.0, z_high: float = 1.7) -> np.ndarray:
+    """Mark the cells of a box centred at (``x``, ``y``) metres, ``width`` x ``depth`` across and
+    from ``z_low`` to ``z_high`` high, in the cell mask ``mask`` (``spec.shape`` bool) as moving:
+    a crude standing person. Returns ``mask``."""
+    low = np.floor((np.array([x - width / 2, y - depth / 2, z_low]) - spec.origin) / spec.cell + 1e-9).astype(int)
+    high = np.floor((np.array([x + width / 2, y + depth / 2, z_high]) - spec.origin) / spec.cell - 1e-9).astype(int) + 1
+    mask[low[0]:high[0], low[1]:high[1], low[2]:high[2]] = True
+    return mask
+
+
+def column_blobs(spec: GridSpec, positions: Sequence[tuple[float, float]], **box) -> list:
+    """The blobs (:func:`occupose.grid.blobs.blobs_from_mask`) of one :func:`mark_column` at
+    each (x, y) of ``positions``; ``box`` : its size keywords."""
+    from occupose.grid.blobs import blobs_from_mask
+
+    mask = np.zeros(spec.shape, bool)
+    for x, y in positions:
+        mark_column(mask, spec, x, y, **box)
+    return blobs_from_mask(mask, spec)[1]
+
 # ------------------------------------------------------------------------- stage 3 alone
 
 

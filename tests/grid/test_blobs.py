@@ -7,23 +7,13 @@ from scipy import ndimage
 from occupose.grid._label_kernels import label_cells
 from occupose.grid.blobs import blobs_from_mask, union_of_blobs
 from occupose.grid.spec import GridSpec
+from occupose.testing import column_blobs, mark_column
 
 SPEC = GridSpec((-2.0, -2.0, 0.0), 0.05, (80, 80, 50))  # 4 x 4 x 2.5 m
 
 
-def column(mask, x, y, *, width=0.3, depth=0.1, z_low=0.0, z_high=1.7, spec=SPEC):
-    """Mark a box of cells centred at (x, y) (metres) as moving: a crude standing person."""
-    low = np.floor((np.array([x - width / 2, y - depth / 2, z_low]) - spec.origin) / spec.cell + 1e-9).astype(int)
-    high = np.floor((np.array([x + width / 2, y + depth / 2, z_high]) - spec.origin) / spec.cell - 1e-9).astype(int) + 1
-    mask[low[0]:high[0], low[1]:high[1], low[2]:high[2]] = True
-    return mask
-
-
 def people(*positions, **box):
-    mask = np.zeros(SPEC.shape, bool)
-    for x, y in positions:
-        column(mask, x, y, **box)
-    return blobs_from_mask(mask, SPEC)[1]
+    return column_blobs(SPEC, positions, **box)
 
 
 # ---------------------------------------------------------------------------- labelling
@@ -68,11 +58,11 @@ def test_blob_geometry():
 
 def test_filter_drops_what_cannot_be_a_person_and_keeps_a_seated_upper_body():
     mask = np.zeros(SPEC.shape, bool)
-    column(mask, -1.5, -1.5)                                               # standing person
-    column(mask, 0.0, -1.5, width=0.4, depth=0.2, z_low=0.75, z_high=1.3)  # seated, behind a table
-    column(mask, 1.5, -1.5, width=1.0, depth=1.0, z_low=0.0, z_high=0.1)   # a rug: flat
-    column(mask, -1.5, 1.5, width=0.1, depth=0.1, z_low=1.0, z_high=1.2)   # a small thing: too few cells
-    column(mask, 1.5, 1.5, width=0.4, depth=0.2, z_low=0.0, z_high=0.5)    # a low box: top too low
+    mark_column(mask, SPEC, -1.5, -1.5)                                               # standing person
+    mark_column(mask, SPEC, 0.0, -1.5, width=0.4, depth=0.2, z_low=0.75, z_high=1.3)  # seated, behind a table
+    mark_column(mask, SPEC, 1.5, -1.5, width=1.0, depth=1.0, z_low=0.0, z_high=0.1)   # a rug: flat
+    mark_column(mask, SPEC, -1.5, 1.5, width=0.1, depth=0.1, z_low=1.0, z_high=1.2)   # a small thing: too few cells
+    mark_column(mask, SPEC, 1.5, 1.5, width=0.4, depth=0.2, z_low=0.0, z_high=0.5)    # a low box: top too low
     _, blobs = blobs_from_mask(mask, SPEC)
     assert sorted(np.round(b.centroid[:2], 1).tolist() for b in blobs) == [[-1.5, -1.5], [0.0, -1.5]]
     _, everything = blobs_from_mask(mask, SPEC, min_cells=1, min_height=0, min_top=0)
@@ -82,10 +72,10 @@ def test_filter_drops_what_cannot_be_a_person_and_keeps_a_seated_upper_body():
 def test_pieces_in_one_column_make_one_blob():
     # a ceiling camera sees the head top, the shoulders and the feet, nothing in between
     mask = np.zeros(SPEC.shape, bool)
-    column(mask, 0.0, 0.0, width=0.2, depth=0.2, z_low=1.6, z_high=1.75)
-    column(mask, 0.0, 0.0, width=0.45, depth=0.25, z_low=1.3, z_high=1.45)
-    column(mask, 0.0, 0.0, width=0.3, depth=0.2, z_low=0.0, z_high=0.1)
-    column(mask, 1.0, 0.0, width=0.45, depth=0.25, z_low=1.3, z_high=1.75)  # someone else, 0.55 m away
+    mark_column(mask, SPEC, 0.0, 0.0, width=0.2, depth=0.2, z_low=1.6, z_high=1.75)
+    mark_column(mask, SPEC, 0.0, 0.0, width=0.45, depth=0.25, z_low=1.3, z_high=1.45)
+    mark_column(mask, SPEC, 0.0, 0.0, width=0.3, depth=0.2, z_low=0.0, z_high=0.1)
+    mark_column(mask, SPEC, 1.0, 0.0, width=0.45, depth=0.25, z_low=1.3, z_high=1.75)  # someone else, 0.55 m away
     labels, blobs = blobs_from_mask(mask, SPEC)
     assert len(blobs) == 2
     assert blobs[0].low[2] == pytest.approx(0.0) and blobs[0].top == pytest.approx(1.75)

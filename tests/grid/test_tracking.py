@@ -3,27 +3,17 @@
 import numpy as np
 import pytest
 
-from occupose.grid.blobs import Blob, blobs_from_mask
+from occupose.grid.blobs import Blob
 from occupose.grid.spec import GridSpec
+from occupose.testing import column_blobs
 from occupose.grid.tracking import BlobTracker
 
 SPEC = GridSpec((-2.0, -2.0, 0.0), 0.05, (80, 80, 50))  # 4 x 4 x 2.5 m
 FPS = 30.0
 
 
-def column(mask, x, y, *, width=0.3, depth=0.1, z_low=0.0, z_high=1.7, spec=SPEC):
-    """Mark a box of cells centred at (x, y) (metres) as moving: a crude standing person."""
-    low = np.floor((np.array([x - width / 2, y - depth / 2, z_low]) - spec.origin) / spec.cell + 1e-9).astype(int)
-    high = np.floor((np.array([x + width / 2, y + depth / 2, z_high]) - spec.origin) / spec.cell - 1e-9).astype(int) + 1
-    mask[low[0]:high[0], low[1]:high[1], low[2]:high[2]] = True
-    return mask
-
-
 def people(*positions, **box):
-    mask = np.zeros(SPEC.shape, bool)
-    for x, y in positions:
-        column(mask, x, y, **box)
-    return blobs_from_mask(mask, SPEC)[1]
+    return column_blobs(SPEC, positions, **box)
 
 
 def run(tracker, frames):
