@@ -207,6 +207,8 @@ def test_a_filter_given_alone_takes_the_layers_it_accepts(tmp_path, small_camera
     assert config.pose.layers == 5  # the same 5 layers in one stage
     config, _ = build_config(None, "ps", {"pose.filter": "apf+ps"})
     assert config.pose.layers == (2, 1, 2)  # ours' split
+    config, _ = build_config(None, "ps", {}, ("grid.max_range=4.2", 'grid.noise_model="none"', "blobs.join_m=none"))
+    assert (config.grid.max_range, config.grid.noise_model, config.blobs.join_m) == (4.2, "none", None)
 
 
 def test_config_command_prints_settings_that_read_back(tmp_path):

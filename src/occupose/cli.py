@@ -145,9 +145,12 @@ def score_text(rec, tracks_path: Path) -> str:
 
 
 def _value(text: str):
-    """A ``--set`` value: TOML syntax (``0.3``, ``true``, ``[2, 1, 2]``, ``"tof"``), else the text."""
+    """A ``--set`` value: TOML syntax (``0.3``, ``true``, ``[2, 1, 2]``, ``"tof"``), ``none``
+    unquoted for none (``"none"`` quoted is the text), else the text."""
     import tomllib
 
+    if text == "none":
+        return None
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
@@ -226,7 +229,7 @@ def _layers(text: str | None):
 @click.option("--config", "config_file", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="TOML or JSON file of settings (see docs/configuration.md); options given here win.")
 @click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
-              help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable).")
+              help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable; none for none).")
 def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config_file,
               assignments) -> None:
     """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json and prints
