@@ -18,7 +18,7 @@ def configuration_markdown() -> str:
     lines = ["# Configuration", "",
              "Every setting of a tracking run is a field of `occupose.config.TrackerConfig`, grouped in",
              "sections. Give them in a TOML or JSON file (`occupose track REC --out OUT --config FILE`), one",
-             "at a time (`--set section.field=value`), or in Python",
+             "at a time (`--set section.field=value`, TOML syntax, `none` for none), or in Python",
              "(`TrackerConfig.from_dict({...})`, `config.with_values({\"section.field\": value})`). A file",
              "may name the `method` it starts from (`ours`, `apf`, `ps`, `part-based`; default `ours`);",
              "`occupose config --method NAME` prints every setting as such a file. Every value is checked",
