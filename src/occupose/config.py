@@ -248,6 +248,13 @@ class StartConfig(_Section):
     spread_position: float = setting(0.05, "spread of the new particles' root x, y, z", "m", low=0)
     spread_heading: float = setting(0.15, "spread of the new particles' heading", "rad", low=0)
     spread_angle: float = setting(0.1, "spread of the new particles' joint angles", "rad", low=0)
+    still_frames: int = setting(1, "on this many first frames, static structures shaped like a person (a head "
+                                   "above wider shoulders) are taken for people standing still, whom the grid "
+                                   "would take for background (0: people start only by moving)", "frames", low=0)
+    still_floor: float = setting(0.15, "looking for still people, cells below this height are left out (a person "
+                                       "stands on the floor)", "m", low=0)
+    still_width: float = setting(1.0, "a still person's occupied cells span at most this much across the floor",
+                                 "m", above=0)
     look_back_s: float = setting(1.0, "a new person is also tracked backwards over at most this much of its "
                                       "blob's frames before its start (0: no look-back)", "s", low=0, high=10)
     look_back_from: int = setting(10, "the backward run starts from the estimate this many frames after the start",

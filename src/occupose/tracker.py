@@ -46,7 +46,7 @@ from occupose.grid.pixels import pixels_from_depth, predicted_from_tracks
 from occupose.grid.tracking import BlobTracker
 from occupose.pose.lookback import LookBack
 from occupose.pose.person import Person, PersonEstimate
-from occupose.pose.start import person_like, start_person
+from occupose.pose.start import person_like, start_person, still_people
 
 #: The stages timed in :attr:`FrameResult.seconds`.
 STAGES = ("grid", "blobs", "observations", "pose")
@@ -144,6 +144,9 @@ class Tracker:
             self._grid_job = None
         else:
             self.grid.update(depths, hold=self._hold())
+        if self.frame < self.config.start.still_frames:  # people still from the first frame are no background
+            self.grid.seed_moving(still_people(self.grid.states, self.spec, depths, self.cameras, self.config.start,
+                                               self.config.size) & ~self.grid.moving_mask())
         clock = _tick(seconds, "grid", clock)
         blobs = self.config.blobs
         labels, found = blobs_from_mask(self.grid.moving_mask(), self.spec, min_cells=blobs.min_cells,

@@ -13,6 +13,7 @@ from occupose.grid.occupancy import (
     FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth,
     frames_until_static, observation_function, spec_from_cameras, transition_matrix,
 )
+from occupose.geometry.primitives import box
 from occupose.grid.spec import GridSpec
 from occupose.joints import JOINT_INDEX
 from occupose.evaluation.pixels import foreground_scores
@@ -438,3 +439,26 @@ def test_a_second_camera_sees_what_the_first_cannot():
     both.update(frame.depth)
     assert np.all(front_only.visibility_at(behind_panel) == HIDDEN)
     assert np.all(both.visibility_at(behind_panel) == VISIBLE)  # hidden only if hidden from every camera
+
+
+def test_seeded_cells_are_moving_until_they_settle_as_entered_cells_do():
+    """A wall seen from frame 0 is background (O); a patch of it seeded M is M as if it had
+    just been entered from E: it turns O again after frames_until_static (77) frames."""
+    camera = Camera("cam", 80, 60, 60.0, 60.0, 39.5, 29.5, 0.001, look_at((0, 0, 1.0), (0, 3, 1.0)))
+    spec = GridSpec((-1.0, 2.5, -0.025), 0.05, (40, 20, 40))
+    grid = OccupancyGrid(spec, camera)
+    wall = render_camera(box((0, 3.5, 1.0), (3.0, 0.05, 1.5), (128, 128, 128)), camera).depth
+    grid.update({"cam": wall})
+    occupied = grid.states == O
+    patch = occupied & (np.arange(spec.shape[0])[:, None, None] < 20)
+    assert patch.sum() > 50 and not grid.moving_mask().any()
+    grid.seed_moving(patch)
+    moving = []
+    for _ in range(90):
+        grid.update({"cam": wall})
+        moving.append(int((grid.moving_mask() & patch).sum()))
+        assert not (grid.moving_mask() & ~patch).any()
+    assert moving[0] == patch.sum() and moving[-1] == 0
+    assert abs(int(np.argmax(np.array(moving) == 0)) + 1 - frames_until_static()) <= 2
+    with pytest.raises(ValueError, match="bool array of the grid's shape"):
+        grid.seed_moving(patch[:-1])

@@ -58,3 +58,68 @@ def test_silhouette_fill_of_solid_and_scattered_pixels():
     assert silhouette_fill(scattered, width) == pytest.approx(0.05, abs=0.01)
     assert silhouette_fill(np.zeros(0, np.int64), width) == 0.0
 
+
+
+@pytest.fixture(scope="module")
+def still_from_frame_0():
+    """no_occlusion's room with its person standing and waving in place from the first frame
+    (procedural motion, 1.7 m tall): 40 frames, and the scene."""
+    import math
+
+    from occupose.body.dims import DEFAULT_DIMS
+    from occupose.synth import motion as sm
+    from occupose.synth.generate import frames
+    from occupose.synth.scenarios import build_scenario
+
+    scenario = build_scenario("no_occlusion", use_mocap=False)
+    builder = sm.MotionBuilder((0.5, 3.0), -math.pi / 2, DEFAULT_DIMS.scaled(1.7), scenario.fps)
+    joints = builder.stand(0.5).wave("right", 3.0, 3).joints()
+    scenario = replace(scenario, people=(replace(scenario.people[0], joints=joints),))
+    return scenario, list(frames(scenario, seed=0, num_frames=40))
+
+
+def test_a_person_still_from_the_first_frame_is_found_and_tracked(still_from_frame_0):
+    """The grid takes a person who stands still from frame 0 for background (only the waving
+    arm moves); the still-person test finds the head above the shoulders at frame 0, and the
+    person starts after start.frames frames. Measured: started at frame 4, 3.1 cm over the
+    scene; without the test (start.still_frames = 0) the arm's blob started a person only at
+    frame 34."""
+    from occupose.config import TrackerConfig
+    from occupose.evaluation.errors import frame_errors, joint_errors
+    from occupose.run import track_frames
+    from occupose.tracker import Tracker
+
+    scenario, rendered = still_from_frame_0
+    gt = np.stack([f.joints[0] for f in rendered])
+    result = track_frames(Tracker(scenario.cameras, scenario.fps, "ours", seed=0), rendered, len(rendered))
+    assert list(result.tracks) == [1]
+    joints = result.tracks[1][0]
+    tracked = np.flatnonzero(np.isfinite(joints[:, 0, 0]))
+    assert tracked[0] <= StartConfig.frames  # from its blob's first frame with the look-back
+    assert np.mean(frame_errors(joint_errors(gt[tracked], joints[tracked]))) < 0.08
+    blind = Tracker(scenario.cameras, scenario.fps, TrackerConfig().with_values({"start.still_frames": 0}), seed=0)
+    assert not track_frames(blind, rendered, 30).tracks
+
+
+def test_still_people_are_people_not_furniture(still_from_frame_0):
+    """At frame 0: the standing person is found (its cells around its pelvis); the first
+    frame of sit_behind_table (a desk, a couch, nobody yet) gives nothing."""
+    from occupose.grid.blobs import blobs_from_mask
+    from occupose.synth.generate import frames
+    from occupose.synth.scenarios import build_scenario
+    from occupose.config import TrackerConfig
+    from occupose.pose.start import still_people
+    from occupose.tracker import Tracker
+
+    off = TrackerConfig().with_values({"start.still_frames": 0})
+    scenario, rendered = still_from_frame_0
+    furnished = build_scenario("sit_behind_table", use_mocap=False)
+    for scene, frame, people in ((scenario, rendered[0], 1),
+                                 (furnished, next(iter(frames(furnished, seed=0, num_frames=1))), 0)):
+        tracker = Tracker(scene.cameras, scene.fps, off)
+        tracker.update(frame.depth)
+        found = still_people(tracker.grid.states, tracker.spec, frame.depth, tracker.cameras, off.start, off.size)
+        blobs = blobs_from_mask(found, tracker.spec, min_cells=1, min_height=0.0, min_top=0.0, join_m=None)[1]
+        assert len(blobs) == people
+        for blob in blobs:
+            assert np.hypot(*(blob.centroid[:2] - frame.joints[0, 2, :2])) < 0.15

@@ -577,6 +577,20 @@ class OccupancyGrid:
         """(nx, ny, nz) bool: cells whose MAP state is M."""
         return self._states == M
 
+    def seed_moving(self, cells: np.ndarray) -> None:
+        """Set the cells of ``cells`` ((nx, ny, nz) bool) to M with certainty: something the
+        grid took for background is known to be a person (a person standing still from the
+        first frame, :func:`occupose.pose.start.still_people`). Such a cell is then as one just
+        entered from E: seen occupied, it turns O after :func:`frames_until_static` frames
+        (77 by default) unless it is held (the tracker holds the people it tracks), and it
+        becomes E when it is seen through."""
+        cells = np.asarray(cells)
+        if cells.shape != self.spec.shape or cells.dtype != np.bool_:
+            raise ValueError(f"cells must be a bool array of the grid's shape {self.spec.shape}, "
+                             f"got {cells.dtype} {cells.shape}")
+        self._probabilities[cells] = (0.0, 1.0, 0.0)
+        self._states[cells] = M
+
     def visibility_at(self, points: np.ndarray) -> np.ndarray:
         """Visibility of the cells containing world points.
 

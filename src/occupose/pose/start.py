@@ -18,13 +18,54 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from occupose.body import BodyModel, body_model, dims_from_observation, seated_pose, standing_pose
-from occupose.body.size import top_height
-from occupose.camera import Camera
-from occupose.config import StartConfig, TrackerConfig
+from occupose.body.size import breadth_profile, neck_and_shoulders, top_height
+from occupose.camera import Camera, points_from_depth
+from occupose.config import SizeConfig, StartConfig, TrackerConfig
+from occupose.grid.blobs import blobs_from_mask
+from occupose.grid.occupancy import O, cells_from_depth
 from occupose.grid.pixels import PersonPixels
+from occupose.grid.spec import GridSpec
 from occupose.likelihood import observation_from_views
 from occupose.pose.person import Person
 from occupose.pose.views import at_border, views_from_pixels
+
+
+def still_people(states: np.ndarray, spec: GridSpec, depths: Mapping[str, np.ndarray], cameras: Sequence[Camera],
+                 config: StartConfig, size: SizeConfig) -> np.ndarray:
+    """(nx, ny, nz) bool: the occupied cells of the static structures shaped like a person.
+
+    The grid learns the background from the first frame, so a person in view and still
+    from then on is background to it, and only what moves starts a person. Here every
+    connected group of cells in state O above ``config.still_floor`` (so that a person
+    standing on the floor is apart from it) whose top is between ``config.min_top`` and
+    the grid's top, that spans at most ``config.still_width`` across the floor, and whose
+    points (those of the camera that sees most of them) show a head above wider
+    shoulders (:func:`occupose.body.size.neck_and_shoulders`: a table, a chair, a cabinet
+    or a wall do not) is taken for a person.
+
+    states : (nx, ny, nz) uint8 grid states; depths : camera name -> (H, W) float32 metres
+    """
+    occupied = states == O
+    occupied[:, :, :int(round((config.still_floor - spec.origin[2]) / spec.cell))] = False
+    labels, blobs = blobs_from_mask(occupied, spec, min_cells=1, min_height=0.0, min_top=config.min_top, join_m=None)
+    found = np.zeros(spec.shape, bool)
+    candidates = [b for b in blobs if np.all(b.high[:2] - b.low[:2] <= config.still_width + 1e-9)
+                  and b.high[2] < spec.high[2] - 1e-9]  # not reaching the grid's top (a wall, a pillar)
+    if not candidates:
+        return found
+    flat = labels.reshape(-1)
+    points_of = {b.label: [] for b in candidates}
+    for camera in cameras:
+        cell = cells_from_depth(depths[camera.name], camera, spec).reshape(-1)
+        points, pixels = points_from_depth(depths[camera.name], camera)
+        label = np.where(cell[pixels] >= 0, flat[np.maximum(cell[pixels], 0)], 0)
+        for b in candidates:
+            points_of[b.label].append(points[label == b.label])
+    for b in candidates:
+        points = max(points_of[b.label], key=len)
+        if len(points) >= size.top_rank and neck_and_shoulders(breadth_profile(points, size), size) is not None:
+            found.reshape(-1)[b.cells] = True
+    return found
 
 
 def person_like(pixels: PersonPixels, cameras: Sequence[Camera], config: StartConfig, top_rank: int) -> bool:
