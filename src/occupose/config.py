@@ -292,6 +292,16 @@ class CarryConfig(_Section):
     walk_from: float = setting(0.5, "speed from which the walking prior starts (slower: standing)", "m/s", low=0)
     walk_ramp: float = setting(0.4, "speed range over which the walking prior ramps up to full weight", "m/s",
                                above=0)
+    twin: bool = setting(False, "compare each estimate with its twin facing the other way and turn to the twin "
+                                "when it explains the points better for long enough (off until measured on the "
+                                "catalogue and the randomized benchmark)")
+    twin_window_s: float = setting(1.0, "the estimate's twin facing the other way (its joints relabelled left "
+                                        "for right) is compared with it over this long", "s", above=0)
+    twin_every: int = setting(3, "the twin is made and compared every this many estimates (making it costs a "
+                                 "least-squares fit, about 5 ms)", "estimates", low=1)
+    twin_share: float = setting(0.8, "the estimate turns to its twin when the twin explains the points better "
+                                     "in at least this share of the window's estimates", "share",
+                                low=0.5, high=1)
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,12 @@ JOINTS: tuple[str, ...] = (
 JOINT_INDEX: dict[str, int] = {name: i for i, name in enumerate(JOINTS)}
 NUM_JOINTS = len(JOINTS)
 
+#: JOINTS[MIRRORED] relabels a skeleton's joints left for right (the same points, the
+#: person taken as facing the other way).
+MIRRORED: tuple[int, ...] = tuple(
+    JOINT_INDEX[name.replace("left", "@").replace("right", "left").replace("@", "right")] for name in JOINTS
+)
+
 #: Joints reported by the upper-body model.
 UPPER_JOINTS: tuple[str, ...] = JOINTS[:9]
 

@@ -98,3 +98,26 @@ def test_pose_from_joints_on_real_mocap(mocap, clip_name, models):
         # measured: walk 1.0 cm (full) / 1.8 cm (upper), wave 3.0 cm (full); a rigid torso
         # cannot shrug one shoulder, and the upper model has no sideways lean
         assert errors.max() < 0.04, name
+
+
+@pytest.mark.parametrize("name", ["full", "upper"])
+def test_twin_pose_is_the_skeleton_relabelled_left_for_right_within_the_joint_limits(name):
+    """The twin of a pose with one arm held out sideways has the pose's joints with left and
+    right swapped, faces the other way, and its twin is the pose again. An elbow bent forward
+    has no twin: the twin's elbow would bend backwards, beyond its limit (what lets the
+    tracker tell a person's front from its back, Person.face_the_better_way)."""
+    from occupose.body import twin_pose
+    from occupose.joints import MIRRORED
+
+    model = body_model(name)
+    pose = standing_pose(model, (0.4, 2.0), 0.3)
+    pose[model.dof("left_shoulder_abd")] = 0.8
+    twin = twin_pose(model, pose)
+    joints = joints_from_poses(model, pose[None])[0]
+    np.testing.assert_allclose(joints_from_poses(model, twin[None])[0], joints[list(MIRRORED)], atol=0.02)  # measured: 1.4 cm at most (the elbows)
+    assert abs((twin[model.dof("heading")] - pose[model.dof("heading")]) % (2 * math.pi) - math.pi) < 0.05
+    np.testing.assert_allclose(joints_from_poses(model, twin_pose(model, twin)[None])[0], joints, atol=0.02)
+    pose[model.dof("left_elbow")] = 1.2
+    bent = joints_from_poses(model, pose[None])[0][list(MIRRORED)]
+    wrist = J["right_wrist"]
+    assert np.linalg.norm(joints_from_poses(model, twin_pose(model, pose)[None])[0][wrist] - bent[wrist]) > 0.07  # measured: 11 cm (full), 10 cm (upper)

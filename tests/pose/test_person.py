@@ -151,3 +151,56 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     for i in range(3):  # speeding up to 0.9 m/s, the blob's velocity lagging at 0.6: the estimates'
         person.settle(person.pose - np.eye(model.num_dofs)[1] * 0.03, np.array([0.0, -0.6]))
     np.testing.assert_allclose(person.step(), [0.0, -0.026], atol=1e-12)  # (2 x 0.02 + 3 x 0.03) / 5
+
+
+def _shoulder_heading(joints: np.ndarray) -> np.ndarray:
+    """(T,) rad: the way a skeleton (T, 15, 3) faces, from its shoulders."""
+    from occupose.joints import JOINT_INDEX
+
+    across = joints[:, JOINT_INDEX["left_shoulder"], :2] - joints[:, JOINT_INDEX["right_shoulder"], :2]
+    return np.arctan2(-across[:, 0], across[:, 1])
+
+
+@pytest.fixture(scope="module")
+def standing_still():
+    """A person standing still 3 m in front of the camera of no_occlusion from the first frame,
+    facing away from it or towards it: 75 rendered frames (2.5 s) each."""
+    import math
+    from dataclasses import replace
+
+    from occupose.body.dims import DEFAULT_DIMS
+    from occupose.synth import motion as sm
+    from occupose.synth.generate import frames
+    from occupose.synth.scenarios import build_scenario
+
+    base = build_scenario("no_occlusion", use_mocap=False)
+    scenes = {}
+    for way, heading in (("away", math.pi / 2), ("towards", -math.pi / 2)):
+        joints = sm.MotionBuilder((0.2, 3.0), heading, DEFAULT_DIMS.scaled(1.75), base.fps).stand(3.0).joints()
+        scene = replace(base, people=(replace(base.people[0], joints=joints),))
+        scenes[way] = scene, list(frames(scene, seed=0, num_frames=75))
+    return scenes
+
+
+@pytest.mark.parametrize("way", ["away", "towards"])
+def test_a_person_standing_still_is_turned_to_the_way_its_limbs_bend(standing_still, way):
+    """Nothing walks to say which way a still person faces; the twin test does (measured
+    on the person facing away: it starts facing the camera, 180 deg off, and is turned in
+    frame 35, after the first window of 1 s; the person facing the camera is never turned)."""
+    from occupose.run import track_frames
+    from occupose.tracker import Tracker
+
+    scene, rendered = standing_still[way]
+    truth = _shoulder_heading(np.stack([f.joints[0] for f in rendered]))
+    runs = {}
+    for twin in ((False, True) if way == "away" else (True,)):
+        tracker = Tracker(scene.cameras, scene.fps, TrackerConfig().with_values({"carry.twin": twin}), seed=0)
+        joints = track_frames(tracker, rendered, len(rendered)).tracks[1][0]
+        tracked = np.isfinite(joints[:, 0, 0])
+        off = np.abs((_shoulder_heading(joints[tracked]) - truth[tracked] + np.pi) % (2 * np.pi) - np.pi)
+        runs[twin] = np.degrees(off)
+    if way == "away":
+        assert np.median(runs[False]) > 150  # without it: facing the camera all along
+        assert runs[True][0] > 150 and np.all(runs[True][-15:] < 30)
+    else:
+        assert np.all(runs[True] < 30)

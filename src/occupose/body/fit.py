@@ -18,7 +18,7 @@ from scipy.optimize import least_squares
 from occupose.body.kinematics import joints_from_poses
 from occupose.body.model import BodyModel
 from occupose.joints import JOINT_INDEX as J
-from occupose.joints import NUM_JOINTS
+from occupose.joints import MIRRORED, NUM_JOINTS
 
 #: Weight of the pull towards the analytic pose, metres of joint error per radian.
 PRIOR_WEIGHT = 1e-3
@@ -198,3 +198,10 @@ def pose_from_joints(model: BodyModel, joints, *, refine: bool = True) -> np.nda
     result = least_squares(residuals, start, jac=jacobian, bounds=(lo, hi), method="trf",
                            x_scale=1.0, xtol=1e-10, ftol=1e-10, max_nfev=200)
     return _inside(model, result.x)
+
+
+def twin_pose(model: BodyModel, pose: np.ndarray) -> np.ndarray:
+    """(D,) the pose of ``model`` whose joints are those of ``pose`` (D,) relabelled left for
+    right: the same skeleton taken as a person facing the other way (heading about + pi,
+    each limb's angles refit within the model's limits)."""
+    return pose_from_joints(model, joints_from_poses(model, np.asarray(pose, np.float64)[None])[0][list(MIRRORED)])

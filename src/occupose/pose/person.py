@@ -28,6 +28,7 @@ from occupose.body import (
     diffusion_scales,
     joints_from_pose,
     pose_from_joints,
+    twin_pose,
     standing_pose,
 )
 from occupose.body.size import breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
@@ -109,6 +110,7 @@ class Person:
         self.part_visible = np.ones(model.num_parts, bool)
         self.fps = fps
         self.since_turn = 0  # estimates since the last turn round (face_the_way_walked)
+        self.twin_better: list[bool] = []  # whether its twin explained the points better (face_the_better_way)
         self.estimates = 0  # estimates since the start (settle)
         self.shapes: list[tuple[float, float]] = []  # (neck depth, shoulder breadth) metres (learn_shape)
         self.shaped = not (config.shape.learn and model.name == "full")  # resized, or never to be
@@ -161,6 +163,7 @@ class Person:
             pose = self._place_hidden_legs(pose, seen)
         self.settle(pose, state.velocity)
         self.face_the_way_walked()
+        self.face_the_better_way()
         self.learn_stature(seen)
         self.learn_shape(seen)
         return self.estimate(True)
@@ -211,16 +214,55 @@ class Person:
         self.since_turn += 1
         if len(self.path) < carry.frames or self.since_turn < carry.frames:
             return
-        velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps * self._time
-        heading = self.problem.heading_dof
-        facing = self.pose[heading]
-        off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
-        fast = carry.walking_speed if self.estimates <= carry.start_check_s * self.fps else carry.later_speed
-        if np.hypot(*velocity) > fast and abs(off) > np.deg2rad(carry.backwards_deg):
+        if self._walks_against(self.pose[self.problem.heading_dof]):
             turn = np.zeros(self.model.num_dofs)
-            turn[heading] = np.pi
+            turn[self.problem.heading_dof] = np.pi
             self.estimator.shift(turn)
             self.pose = self.estimator.filter.estimate.copy()
+            self.since_turn = 0
+
+    def _walks_against(self, facing: float) -> bool:
+        """Whether the person has walked faster than ``carry.walking_speed`` (in its first
+        ``carry.start_check_s`` seconds; later ``carry.later_speed``) over the last
+        ``carry.frames`` estimates in a direction more than ``carry.backwards_deg`` from
+        ``facing`` (rad, the heading dof)."""
+        carry = self.config.carry
+        if len(self.path) < carry.frames:
+            return False
+        velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps * self._time
+        off = (np.arctan2(velocity[1], velocity[0]) - facing + np.pi) % (2 * np.pi) - np.pi
+        fast = carry.walking_speed if self.estimates <= carry.start_check_s * self.fps else carry.later_speed
+        return bool(np.hypot(*velocity) > fast and abs(off) > np.deg2rad(carry.backwards_deg))
+
+    def face_the_better_way(self) -> None:
+        """With ``carry.twin``: go on with the estimate's twin (its joints relabelled left for
+        right, :func:`occupose.body.twin_pose`) when the twin explained the person's points
+        better than the estimate in at least ``carry.twin_share`` of the comparisons (one
+        every ``carry.twin_every`` estimates) of the last ``carry.twin_window_s`` seconds.
+        A person who does not walk faces either way as far as the walking prior knows, and a body turned round fits its points about
+        as well: what tells the halves apart is the limbs, whose joint limits bend them only
+        one way (knees back, elbows and raised arms forward), so the wrong half's estimate
+        explains its points a little worse most of the time. Measured on a still person
+        seen from the front, the back and the side (notes/2026-12-04-twin-test.md): the twin
+        of an estimate facing the wrong way explains better in 78-98 % of frames, of one
+        facing the right way in 10-34 %. While the person walks, a twin that would face
+        against the way walked (:meth:`face_the_way_walked`'s test) is not even made:
+        walking says more."""
+        carry = self.config.carry
+        if not carry.twin or self.estimates % carry.twin_every:
+            return
+        heading = self.problem.heading_dof
+        if self._walks_against(self.pose[heading] + np.pi):
+            self.twin_better = []
+            return
+        twin = twin_pose(self.model, self.pose)
+        better = self.problem.log_likelihood(np.stack([self.pose, twin])).sum(axis=1)
+        window = max(1, int(round(carry.twin_window_s * self.fps / carry.twin_every)))
+        self.twin_better = (self.twin_better + [bool(better[1] > better[0])])[-window:]
+        if len(self.twin_better) == window and np.mean(self.twin_better) >= carry.twin_share:
+            self.estimator.shift(twin - self.pose)
+            self.pose = twin
+            self.twin_better = []
             self.since_turn = 0
 
     def learn_shape(self, observation: Observation) -> None:
