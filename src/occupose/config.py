@@ -300,7 +300,7 @@ class CarryConfig(_Section):
     twin_every: int = setting(3, "the twin is made and compared every this many estimates (making it costs a "
                                  "least-squares fit, about 5 ms)", "estimates", low=1)
     twin_share: float = setting(0.8, "the estimate turns to its twin when the twin explains the points better "
-                                     "in at least this share of the window's estimates", "share",
+                                     "in at least this share of the window's comparisons", "share",
                                 low=0.5, high=1)
 
 

@@ -28,8 +28,8 @@ from occupose.body import (
     diffusion_scales,
     joints_from_pose,
     pose_from_joints,
-    twin_pose,
     standing_pose,
+    twin_pose,
 )
 from occupose.body.size import breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
 from occupose.camera import Camera
@@ -239,10 +239,11 @@ class Person:
         right, :func:`occupose.body.twin_pose`) when the twin explained the person's points
         better than the estimate in at least ``carry.twin_share`` of the comparisons (one
         every ``carry.twin_every`` estimates) of the last ``carry.twin_window_s`` seconds.
-        A person who does not walk faces either way as far as the walking prior knows, and a body turned round fits its points about
-        as well: what tells the halves apart is the limbs, whose joint limits bend them only
-        one way (knees back, elbows and raised arms forward), so the wrong half's estimate
-        explains its points a little worse most of the time. Measured on a still person
+        A person who does not walk faces either way as far as the walking prior knows, and
+        a body turned round fits its points about as well: what tells the halves apart is
+        the limbs, whose joint limits bend them only one way (knees back, elbows and raised
+        arms forward), so the wrong half's estimate explains its points a little worse most
+        of the time. Measured on a still person
         seen from the front, the back and the side (notes/2026-12-04-twin-test.md): the twin
         of an estimate facing the wrong way explains better in 78-98 % of frames, of one
         facing the right way in 10-34 %. While the person walks, a twin that would face
