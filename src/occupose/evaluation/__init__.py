@@ -3,6 +3,8 @@
 - `errors`: joint and frame errors, the FAIL rule, Table I rows (`table_row`, `TableRow`).
 - `matching`: tracks matched to ground-truth people, identity switches, `score` of a sequence.
 - `pixels`: pixel assignment accuracy, foreground scores, the second paper's arm error.
+- `robustness`: per person-run figures (joints within 10 cm, track counts) and their aggregates
+  per condition bucket, for the robustness benchmark.
 - `report`: the one markdown table writer, Table I, results.csv, report.md and its plots.
 - `evaluate`: methods x scenarios x seeds on a worker pool. Its function of the same name
   is not exported here, so that ``occupose.evaluation.evaluate`` stays the module:
