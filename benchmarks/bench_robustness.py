@@ -7,7 +7,9 @@ scored by today's scorer (occupose.evaluation.robustness), so that old code is j
 same rules as new. ``--baseline COMMIT`` tracks the same recordings with that commit's code
 as well: a git worktree of it (``~/.cache/occupose/worktrees/<commit>``, made once) run by
 this interpreter with its ``src`` first on the path, so it must need no library this
-environment lacks. 931038f reads today's recordings.
+environment lacks. 931038f reads today's recordings. ``--variant "carry.twin=true"`` tracks
+them with today's code and those settings as well (``occupose track --set``), for an A/B of
+a setting in the same run.
 
 The small version (`run`, called by ``make bench``): ``SMALL_SCENES`` x 1 seed x
 ``SMALL_FRAMES`` frames, today's code only. The full version, as the issue asks::
@@ -29,6 +31,7 @@ import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Sequence
 from pathlib import Path
 
 from tqdm import tqdm
@@ -87,22 +90,24 @@ def baseline_tree(commit: str) -> Path:
     return tree
 
 
-def track_command(source: Path, recording: Path, out: Path, seed: int) -> tuple[list[str], dict[str, str]]:
+def track_command(source: Path, recording: Path, out: Path, seed: int, settings: Sequence[str] = ()
+                  ) -> tuple[list[str], dict[str, str]]:
     """(argv, environment) of ``occupose track`` of the code in ``source`` (a folder holding
-    the ``occupose`` package) on one recording, with one numba thread."""
+    the ``occupose`` package) on one recording, with one numba thread and the ``--set``
+    assignments ``settings`` (``KEY=VALUE``)."""
     env = dict(os.environ, PYTHONPATH=str(source), NUMBA_NUM_THREADS="1")
     argv = [sys.executable, "-c", _LAUNCH, "track", str(recording), "--out", str(out), "--seed", str(seed)]
-    return argv, env
+    return argv + [f"--set={assignment}" for assignment in settings], env
 
 
-def _track(task: tuple[Path, Path, Path, int]) -> Path:
-    source, recording, out, seed = task
+def _track(task: tuple[Path, Sequence[str], Path, Path, int]) -> Path:
+    source, settings, recording, out, seed = task
     if (out / "tracks.csv").is_file() and (out / "summary.json").is_file():
         return out  # tracked by an earlier, whole run
     partial = out.with_name(out.name + ".partial")  # renamed when whole: an interrupted run is redone
     for stale in (partial, out):
         shutil.rmtree(stale, ignore_errors=True)
-    argv, env = track_command(source, recording, partial, seed)
+    argv, env = track_command(source, recording, partial, seed, settings)
     done = subprocess.run(argv, env=env, capture_output=True, text=True)
     if done.returncode:
         raise RuntimeError(f"tracking {recording} failed ({done.returncode}):\n{done.stderr[-2000:]}")
@@ -123,32 +128,46 @@ def score_folder(scene: str, seed: int, recording: Path, run: Path) -> Run:
 
 
 def benchmark(scenes: list[str], seeds: int, frames: int | None, out: Path, baseline: str | None = None,
-              jobs: int = 2, procedural: bool = False) -> dict[str, list[Run]]:
-    """Render, track and score; ``{code label: runs}``, the baseline (if any) first."""
+              jobs: int = 2, procedural: bool = False, variants: Sequence[str] = ()) -> dict[str, list[Run]]:
+    """Render, track and score; ``{code label: runs}``, the baseline (if any) first, then
+    today's code, then today's code with each of ``variants`` (``KEY=VALUE[;KEY=VALUE...]``,
+    settings as ``occupose track --set`` takes them; labelled by that string)."""
     from occupose.evaluation.evaluate import render_recording
 
-    codes = {}
+    codes: dict[str, tuple[Path, tuple[str, ...]]] = {}
     if baseline is not None:
-        codes[baseline] = baseline_tree(baseline) / "src"
-    codes[CURRENT] = ROOT / "src"
+        codes[baseline] = (baseline_tree(baseline) / "src", ())
+    codes[CURRENT] = (ROOT / "src", ())
+    for variant in variants:
+        settings = tuple(a.strip() for a in variant.split(";") if a.strip())
+        if not settings or not all("=" in a for a in settings):
+            raise ValueError(f"a variant is KEY=VALUE[;KEY=VALUE...], got {variant!r}")
+        codes[variant] = (ROOT / "src", settings)
     recordings = {}
     for scene in tqdm(scenes, desc="rendering", unit="scene"):
         recordings[scene] = render_recording(scene, out / "recordings" / scene, frames, procedural)
-    # a fresh run folder per invocation of today's code (it changes); a baseline commit's runs are kept
-    shutil.rmtree(out / "runs" / CURRENT, ignore_errors=True)
-    tasks = [(source, recordings[scene], out / "runs" / label / scene / str(seed), seed)
-             for label, source in codes.items() for scene in scenes for seed in range(seeds)]
+    folders = {label: out / "runs" / (_folder_name(label) if label in variants else label) for label in codes}
+    for label in codes:  # today's code changes: its runs are made afresh; a baseline commit's are kept
+        if label != baseline:
+            shutil.rmtree(folders[label], ignore_errors=True)
+    tasks = [(source, settings, recordings[scene], folders[label] / scene / str(seed), seed)
+             for label, (source, settings) in codes.items() for scene in scenes for seed in range(seeds)]
     for task in tasks:
-        task[2].parent.mkdir(parents=True, exist_ok=True)
+        task[3].parent.mkdir(parents=True, exist_ok=True)
     with ThreadPoolExecutor(jobs) as pool:
         list(tqdm(pool.map(_track, tasks), total=len(tasks), desc="tracking", unit="run"))
     results: dict[str, list[Run]] = {label: [] for label in codes}
     for label in codes:
         for scene in scenes:
             for seed in range(seeds):
-                run = out / "runs" / label / scene / str(seed)
+                run = folders[label] / scene / str(seed)
                 results[label].append(score_folder(scene, seed, recordings[scene], run))
     return results
+
+
+def _folder_name(variant: str) -> str:
+    """A folder name for a variant's runs: its settings with unsafe characters replaced."""
+    return "set-" + "".join(c if c.isalnum() or c in "._=-" else "_" for c in variant)
 
 
 def tables(results: dict[str, list[Run]]) -> str:
@@ -199,6 +218,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=SMALL_SEEDS, help="tracker seeds 0..N-1 per scene")
     parser.add_argument("--frames", type=int, default=SMALL_FRAMES, help="frames per scene (0: all)")
     parser.add_argument("--baseline", default=None, help="also track with this commit's code (e.g. 931038f)")
+    parser.add_argument("--variant", action="append", default=[], metavar="KEY=VALUE[;KEY=VALUE]",
+                        help="also track with today's code and these settings (repeatable)")
     parser.add_argument("--jobs", type=int, default=2, help="tracking processes at a time")
     parser.add_argument("--procedural", action="store_true", help="procedural motion even with the shared mocap")
     parser.add_argument("--out", type=Path, default=RESULTS, help="folder for recordings, runs and the tables")
@@ -207,7 +228,8 @@ def main(argv: list[str] | None = None) -> None:
         parser.error("--seeds and --jobs must be >= 1, --frames >= 0")
     started = time.time()
     scenes = scene_names(args.scenes)
-    results = benchmark(scenes, args.seeds, args.frames or None, args.out, args.baseline, args.jobs, args.procedural)
+    results = benchmark(scenes, args.seeds, args.frames or None, args.out, args.baseline, args.jobs, args.procedural,
+                        args.variant)
     note = (f"{len(scenes)} scenes x {args.seeds} seeds, {args.frames or 'all'} frames, "
             f"{time.strftime('%Y-%m-%d')}, {time.time() - started:.0f} s.")
     print(tables(results))

@@ -96,7 +96,11 @@ def test_a_tiny_benchmark_run_scores_a_rendered_scene(tmp_path):
     assert scene_names("a,random:2") == ["a", "random-0", "random-1"]
     with pytest.raises(ValueError, match="positive count"):
         scene_names("random:0")
-    results = benchmark(["no_occlusion"], seeds=1, frames=20, out=tmp_path, procedural=True, jobs=1)
+    results = benchmark(["no_occlusion"], seeds=1, frames=20, out=tmp_path, procedural=True, jobs=1,
+                        variants=["pose.particles=50"])
+    assert list(results) == [CURRENT, "pose.particles=50"]
+    summary = json.loads((tmp_path / "runs" / "set-pose.particles=50" / "no_occlusion" / "0" / "summary.json").read_text())
+    assert summary["config"]["pose"]["particles"] == 50
     (run,) = results[CURRENT]
     assert run.conditions == {"view": "front", "people": 1} and run.people == 1
     (person,) = run.persons
