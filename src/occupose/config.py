@@ -153,8 +153,9 @@ class GridConfig(_Section):
     cell: float = setting(0.05, "edge of a grid cell", "m", low=0.02, high=0.5)
     height: float = setting(2.2, "top of the grid above the floor (the floor z = 0 is its bottom)", "m", above=0.0)
     max_range: float | None = setting(None, "how far along its optical axis each camera's view is kept; none: "
-                                            "the camera's sensor preset's far range (4.5 m for a camera that "
-                                            "matches no preset)", "m", above=0.0)
+                                            "the camera's sensor preset's far range (for a camera that matches "
+                                            "no preset: the farthest depth it measured with grid.noise_model "
+                                            "measured, else 4.5 m)", "m", above=0.0)
     noise_model: str | None = setting(None, "depth noise model of every camera; none: the camera's sensor preset's "
                                             "(structured_light for a camera that matches no preset); measured: "
                                             "each camera's own, from the temporal spread of its static pixels in "
