@@ -75,6 +75,8 @@ MIN_NOISE_FRAMES = 3
 _TRIM = 5.0
 #: Depth bins needed to fit all three coefficients; with fewer, c1 = 0 (see :func:`_fit`).
 _FULL_FIT_BINS = 4
+#: A bin whose std is this factor off the fit of the others is dropped (see :func:`estimate_depth_noise`).
+_BIN_OUTLIER = 1.5
 #: Percentile of the valid depths taken as the farthest depth a camera measures.
 _FAR_PERCENTILE = 99.9
 #: MAD to standard deviation for a Gaussian.
@@ -139,7 +141,11 @@ def estimate_depth_noise(depths, *, bin_width: float = GridConfig.noise_bin,
     stays) and corrected for the mean's degree of freedom (x sqrt(T / (T - 1))). It is
     the std of the readings themselves, quantisation steps included (a Kinect v1's
     disparity steps are 5 cm at 4 m), which is what the named models give. Bins with
-    fewer than ``min_pixels`` static pixels are dropped.
+    fewer than ``min_pixels`` static pixels are dropped. A bin more than half of whose
+    pixels something moved through (a person walking at that depth for all the frames)
+    has the mover's spread as its median, so its cut lets the mover in: while at least 3
+    bins remain, the bin farthest off the fit of the bins, if more than 1.5 times off (either
+    way), is dropped and the rest refitted.
 
     The bins' stds are fitted (least squares of the relative error) with c0 + c1 z + c2 z^2
     when there are at least 4 bins and that fit has c2 >= 0 and stays positive for
@@ -186,9 +192,16 @@ def estimate_depth_noise(depths, *, bin_width: float = GridConfig.noise_bin,
         raise ValueError(f"estimating the depth noise needs a depth bin ({bin_width:g} m) with at least "
                          f"{min_pixels} static pixels measured in all {num_frames} frames; the frames have "
                          f"{series.shape[0]} such pixels in all")
-    z, s = np.array(depths_b), np.array(stds_b)
-    return NoiseEstimate(_fit(z, s), int(sum(pixels_b)), num_frames, (float(z.min()), float(z.max())), z, s,
-                         np.array(pixels_b, np.int64), far)
+    z, s, n = np.array(depths_b), np.array(stds_b), np.array(pixels_b, np.int64)
+    coefficients = _fit(z, s)
+    while z.size >= 3:  # drop the bin farthest off the others' fit while it is off by more than _BIN_OUTLIER
+        ratio = np.abs(np.log(np.maximum(s, 1e-9) / np.maximum(std_from_coefficients(z, coefficients), 1e-9)))
+        worst = int(np.argmax(ratio))
+        if ratio[worst] <= math.log(_BIN_OUTLIER):
+            break
+        z, s, n = (np.delete(a, worst) for a in (z, s, n))
+        coefficients = _fit(z, s)
+    return NoiseEstimate(coefficients, int(n.sum()), num_frames, (float(z.min()), float(z.max())), z, s, n, far)
 
 
 def _fit(z: np.ndarray, s: np.ndarray) -> np.ndarray:
