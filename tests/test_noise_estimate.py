@@ -143,3 +143,21 @@ def test_the_measured_path_records_each_cameras_noise_in_the_summary(tmp_path):
     named = track_recording(tmp_path / "rec", TrackerConfig())
     assert named.noise["front"] == {"model": "tof", "coefficients": [1.5e-3, -0.5e-3, 0.3e-3], "max_range": 4.5,
                                     "preset": "kinect_v2"}
+
+
+def test_a_depth_bin_mostly_crossed_by_a_mover_is_left_out():
+    """70 % of the pixels of the 2.5-2.75 m bin are crossed by something in half the frames
+    (up to 30 cm nearer): the bin's median spread is the mover's, its static cut lets the
+    mover in, and the bin reads far above the others' fit; it is dropped."""
+    depths, _ = _static_scene("kinect_v2", 2.0)
+    mean = depths.mean(axis=0)
+    rng = np.random.default_rng(1)
+    crossed = (mean >= 2.5) & (mean < 2.75) & (rng.random(mean.shape) < 0.7) & (depths > 0).all(axis=0)
+    assert crossed.sum() > 1000
+    moved = depths.copy()
+    for t in range(0, NUM_FRAMES, 2):
+        moved[t][crossed] -= 0.3 * rng.random(int(crossed.sum())).astype(np.float32)
+    estimate = estimate_depth_noise(moved)
+    assert not np.any((estimate.bin_depths >= 2.5) & (estimate.bin_depths < 2.75)), estimate.bin_depths
+    for z in (1.8, 2.6, 3.0):
+        assert estimate.std(z) == pytest.approx(2.0 * depth_std(z, "tof"), rel=0.2)

@@ -473,7 +473,8 @@ class OccupancyGrid:
             offset += cam.width * cam.height
             self._half_extents[c] = 0.5 * self.spec.cell * np.abs(pose[2, :3]).sum()
             model = self.noise_models[cam.name]
-            self._sigma_lut[c] = model.std(lut_depths) if isinstance(model, NoiseEstimate) else depth_std(lut_depths, model)
+            measured = isinstance(model, NoiseEstimate)
+            self._sigma_lut[c] = model.std(lut_depths) if measured else depth_std(lut_depths, model)
         self._depth = np.empty(offset, np.float32)
 
     def depth_noise(self, depth_l, camera: str) -> np.ndarray:
