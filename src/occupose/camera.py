@@ -15,6 +15,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from occupose.config import GridConfig
+
 #: Keys of a camera entry in ``recording.json``, in the order they are written.
 CAMERA_KEYS: tuple[str, ...] = (
     "name", "width", "height", "fx", "fy", "cx", "cy", "depth_scale", "world_from_camera",
@@ -407,3 +409,28 @@ def camera_preset(name: str, *, world_from_camera=None, camera_name: str = "cam0
         fx=spec.fx, fy=spec.fy, cx=spec.cx, cy=spec.cy,
         world_from_camera=np.eye(4) if world_from_camera is None else world_from_camera,
     )
+
+
+def matching_preset(camera: Camera, tolerance: float | None = None) -> str | None:
+    """The name of the sensor preset (CAMERA_PRESETS) ``camera`` is, or None.
+
+    A camera is a preset when its image size is the preset's and each of its fx, fy, cx,
+    cy is within ``tolerance`` (a share, default ``grid.preset_tolerance``: 0.05) of the
+    preset's value: a real calibration differs from the nominal intrinsics by a few
+    percent. The presets have one resolution each, so a camera of another size (a binned
+    or cropped mode) matches none. When several presets match, the closest one (smallest
+    largest relative difference) is taken.
+    """
+    if not isinstance(camera, Camera):
+        raise ValueError(f"camera must be an occupose.camera.Camera, got {type(camera).__name__}")
+    tolerance = GridConfig.preset_tolerance if tolerance is None else tolerance
+    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not 0.0 <= tolerance < 1.0:
+        raise ValueError(f"tolerance must be a share in [0, 1), got {tolerance!r}")
+    best, best_off = None, math.inf
+    for spec in CAMERA_PRESETS.values():
+        if (spec.width, spec.height) != (camera.width, camera.height):
+            continue
+        off = max(abs(getattr(camera, k) - getattr(spec, k)) / abs(getattr(spec, k)) for k in ("fx", "fy", "cx", "cy"))
+        if off <= tolerance and off < best_off:
+            best, best_off = spec.name, off
+    return best

@@ -153,11 +153,26 @@ class GridConfig(_Section):
     cell: float = setting(0.05, "edge of a grid cell", "m", low=0.02, high=0.5)
     height: float = setting(2.2, "top of the grid above the floor (the floor z = 0 is its bottom)", "m", above=0.0)
     max_range: float | None = setting(None, "how far along its optical axis each camera's view is kept; none: "
-                                            "the camera's sensor preset's far range (4.5 m for a camera that "
-                                            "matches no preset)", "m", above=0.0)
+                                            "the camera's sensor preset's far range (for a camera that matches "
+                                            "no preset: the farthest depth it measured with grid.noise_model "
+                                            "measured, else 4.5 m)", "m", above=0.0)
     noise_model: str | None = setting(None, "depth noise model of every camera; none: the camera's sensor preset's "
-                                            "(structured_light for a camera that matches no preset)",
-                                      choices=NOISE_MODEL_NAMES)
+                                            "(structured_light for a camera that matches no preset); measured: "
+                                            "each camera's own, from the temporal spread of its static pixels in "
+                                            "the first grid.noise_frames frames",
+                                      choices=NOISE_MODEL_NAMES + ("measured",))
+    noise_frames: int = setting(30, "grid.noise_model measured: frames at the start of a recording whose static "
+                                    "pixels give each camera's depth noise", "frames", low=3, high=1000)
+    noise_bin: float = setting(0.25, "grid.noise_model measured: width of the depth bins the noise is measured "
+                                     "in", "m", low=0.05, high=2.0)
+    noise_static_cut: float = setting(3.0, "grid.noise_model measured: a pixel is static when its temporal std is "
+                                           "at most its depth bin's median plus this many robust spreads (MAD "
+                                           "x 1.4826) of the bin's pixels", "spreads", above=0)
+    noise_min_pixels: int = setting(200, "grid.noise_model measured: fewest static pixels of a depth bin that is "
+                                         "used", "pixels", low=10)
+    preset_tolerance: float = setting(0.05, "a camera is taken for a sensor preset (its noise model and far "
+                                            "range) when its image size is the preset's and its fx, fy, cx, cy "
+                                            "are within this share of the preset's", "share", low=0, high=0.5)
     alpha: float = setting(0.01, "HMM transition O -> E: a static object is removed", "probability", low=0, high=1)
     beta: float = setting(0.1, "HMM transition E -> M: something enters a free cell", "probability", low=0, high=1)
     gamma: float = setting(0.4, "HMM transition M -> E: a moving object leaves", "probability", low=0, high=1)

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from occupose.config import TrackerConfig, method_config
+from occupose.grid.noise import measure_noise
 from occupose.joints import NUM_JOINTS
 from occupose.tracker import STAGES, Tracker
 
@@ -36,6 +37,7 @@ class TrackingResult:
     config : the settings of the run; seed : its seed; model : the body model it used
     overlap : whether the grid ran a frame ahead on a second thread (its hold mask then
         comes from the bodies one frame older, so the tracks may differ)
+    noise : camera name -> what the grid assumed of it (:meth:`occupose.grid.noise.CameraNoise.to_dict`)
     """
 
     tracks: dict[int, tuple[np.ndarray, np.ndarray]]
@@ -46,6 +48,7 @@ class TrackingResult:
     seed: int = 0
     model: str = ""
     overlap: bool = False
+    noise: dict[str, dict] = field(default_factory=dict)
 
 
 def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: Callable[[int], None] | None = None,
@@ -88,7 +91,8 @@ def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: 
     tracker.close()
     fps = (num_frames - 1) / total if num_frames > 1 and total > 0 else 0.0
     return TrackingResult({t: (joints[t], visible[t]) for t in sorted(joints)}, dict(seconds, total=total,
-                          startup=startup), fps, num_frames, tracker.config, tracker.seed, tracker.model_name, overlap)
+                          startup=startup), fps, num_frames, tracker.config, tracker.seed, tracker.model_name, overlap,
+                          {name: c.to_dict() for name, c in tracker.noise.items()})
 
 
 def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: int = 0,
@@ -100,6 +104,8 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     seed : the run's seed; progress : callable(n) after each frame, or None
     overlap : as :func:`track_frames`; off by default: on an idle 2-core machine the grid's
         thread competes with the likelihood kernels' two threads (benchmarks/bench_speed.py)
+    With ``grid.noise_model`` measured, each camera's noise is measured from the first
+    ``grid.noise_frames`` frames first (:func:`occupose.grid.noise.measure_noise`).
     An empty recording (no frames) gives an empty result.
     """
     from occupose.io.recording import Recording
@@ -110,17 +116,22 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
         raise ValueError(f"recording must be a Recording or the path of a recording folder, got "
                          f"{type(recording).__name__}")
     config = method_config(config) if isinstance(config, str) else config
-    tracker = Tracker(recording.cameras, recording.fps, config, seed=seed)
+    noise = None
+    if config.grid.noise_model == "measured":
+        first = (frame.depth for frame in itertools.islice(recording.frames(), config.grid.noise_frames))
+        noise = measure_noise(recording.cameras, first, config.grid)
+    tracker = Tracker(recording.cameras, recording.fps, config, seed=seed, noise=noise)
     return track_frames(tracker, recording.frames(), recording.num_frames, progress, overlap=overlap)
 
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:
     """The ``summary.json`` of a run: the recording, the method's name (if it was run as
     one: the base of its config), seed, body model, the whole resolved config, whether the
-    grid ran ahead on a thread, frames, people, seconds per stage and frames/s (start-up
-    excluded)."""
+    grid ran ahead on a thread, each camera's noise model and far range, frames, people,
+    seconds per stage and frames/s (start-up excluded)."""
     return {"recording": str(recording_path), "method": method, "seed": result.seed, "model": result.model,
-            "config": result.config.to_dict(), "overlap": result.overlap, "frames": result.num_frames, "people": len(result.tracks),
+            "config": result.config.to_dict(), "overlap": result.overlap, "noise": result.noise,
+            "frames": result.num_frames, "people": len(result.tracks),
             "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
 
 

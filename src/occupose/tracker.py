@@ -41,12 +41,14 @@ from occupose.camera import Camera
 from occupose.config import ConfigError, TrackerConfig, method_config
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
+from occupose.grid.noise import camera_noise
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.pixels import pixels_from_depth, predicted_from_tracks
 from occupose.grid.tracking import BlobTracker
 from occupose.pose.lookback import LookBack
 from occupose.pose.person import Person, PersonEstimate
 from occupose.pose.start import person_like, start_person, still_people
+from occupose.sensors import NoiseEstimate
 
 #: The stages timed in :attr:`FrameResult.seconds`.
 STAGES = ("grid", "blobs", "observations", "pose")
@@ -82,9 +84,15 @@ class Tracker:
     config : a TrackerConfig, or the name of a method of :data:`occupose.config.METHODS`
         (default ``ours``)
     seed : int, seeds every person's filter (person n gets a generator spawned from it)
+    noise : None or camera name -> :class:`occupose.sensors.NoiseEstimate`, each camera's
+        measured depth noise (:func:`occupose.grid.noise.measure_noise` of the first
+        ``grid.noise_frames`` frames; :func:`occupose.run.track_recording` does it); needed
+        with ``grid.noise_model`` measured. ``noise`` (after construction): camera name ->
+        :class:`occupose.grid.noise.CameraNoise`, what the grid assumes of each camera.
     """
 
-    def __init__(self, cameras, fps: float, config: TrackerConfig | str = "ours", *, seed: int = 0):
+    def __init__(self, cameras, fps: float, config: TrackerConfig | str = "ours", *, seed: int = 0,
+                 noise: Mapping[str, NoiseEstimate] | None = None):
         config = method_config(config) if isinstance(config, str) else config
         if not isinstance(config, TrackerConfig):
             raise ConfigError(f"config must be a TrackerConfig or a method name, got {type(config).__name__}")
@@ -95,11 +103,12 @@ class Tracker:
         pose = config.pose
         self.model_name = model_for(cameras, pose.steep_down_deg) if pose.model == "auto" else pose.model
         grid = config.grid
-        self.spec = spec_from_cameras(cameras, cell=grid.cell, height=grid.height, max_range=grid.max_range)
-        noise = None if grid.noise_model is None else {c.name: grid.noise_model for c in cameras}
-        self.grid = OccupancyGrid(self.spec, cameras, noise, alpha=grid.alpha, beta=grid.beta, gamma=grid.gamma,
-                                  psi=grid.psi, p_occ=grid.p_occ, p_free=grid.p_free, tail_width=grid.tail_width,
-                                  initial=grid.initial, max_range=grid.max_range)
+        self.noise = camera_noise(cameras, grid, noise)
+        far = {name: c.max_range for name, c in self.noise.items()}
+        self.spec = spec_from_cameras(cameras, cell=grid.cell, height=grid.height, max_range=far)
+        self.grid = OccupancyGrid(self.spec, cameras, {name: c.model for name, c in self.noise.items()},
+                                  alpha=grid.alpha, beta=grid.beta, gamma=grid.gamma, psi=grid.psi, p_occ=grid.p_occ,
+                                  p_free=grid.p_free, tail_width=grid.tail_width, initial=grid.initial, max_range=far)
         blobs = config.blobs
         self.blobs = BlobTracker(self.fps, blobs.max_gap_s, gate_m=blobs.gate_m, gate_growth=blobs.gate_growth,
                                  claim_share=blobs.claim_share, merge_margin_m=blobs.merge_margin_m,

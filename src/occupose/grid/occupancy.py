@@ -110,11 +110,11 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, pixels_from_points
+from occupose.camera import CAMERA_PRESETS, Camera, SensorSpec, matching_preset, pixels_from_points
 from occupose.config import GridConfig
 from occupose.grid import _kernels
 from occupose.grid.spec import GridSpec
-from occupose.sensors import depth_std, depth_std_coefficients
+from occupose.sensors import NoiseEstimate, depth_std, depth_std_coefficients
 
 #: Cell states (index into the last axis of ``OccupancyGrid.probabilities``).
 O, M, E = 0, 1, 2
@@ -218,12 +218,9 @@ def frames_until_static(alpha: float = ALPHA, beta: float = BETA, gamma: float =
 
 
 def _preset_of(camera: Camera) -> SensorSpec | None:
-    """The sensor preset whose image size and intrinsics the camera has, if any."""
-    for spec in CAMERA_PRESETS.values():
-        if (spec.width, spec.height, spec.fx, spec.fy, spec.cx, spec.cy) == (
-                camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy):
-            return spec
-    return None
+    """The sensor preset the camera is (:func:`occupose.camera.matching_preset`), if any."""
+    name = matching_preset(camera)
+    return None if name is None else CAMERA_PRESETS[name]
 
 
 def _check_cameras(cameras) -> tuple[Camera, ...]:
@@ -397,9 +394,10 @@ class OccupancyGrid:
     spec : GridSpec (see :func:`spec_from_cameras`)
     cameras : Camera or sequence of Camera (unique names)
     noise_models : None or dict camera name -> noise model name of :mod:`occupose.sensors`
-        (``"structured_light"``, ``"tof"``, ``"none"``): sets each camera's depth tolerance.
-        Default: the camera's sensor preset's model when its intrinsics match a preset,
-        else DEFAULT_NOISE_MODEL.
+        (``"structured_light"``, ``"tof"``, ``"none"``) or a measured
+        :class:`occupose.sensors.NoiseEstimate`: sets each camera's depth tolerance.
+        Default: the camera's sensor preset's model when its intrinsics match a preset
+        (:func:`occupose.camera.matching_preset`), else DEFAULT_NOISE_MODEL.
     alpha, beta, gamma, psi : transition probabilities (module docstring)
     p_occ, p_free : the observation function's levels; tail_width : width of its tails in
         sensor depth standard deviations (module docstring)
@@ -411,7 +409,7 @@ class OccupancyGrid:
     (nx, ny, nz) uint8 (VISIBLE, HIDDEN, UNOBSERVED), ``num_updates`` frames seen.
     """
 
-    def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str] | None = None, *,
+    def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str | NoiseEstimate] | None = None, *,
                  alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
                  p_occ: float = P_OCC, p_free: float = P_FREE, tail_width: float = TAIL_WIDTH,
                  initial=INITIAL, max_range=None):
@@ -436,13 +434,14 @@ class OccupancyGrid:
         if noise_models is None:
             noise_models = {}
         elif not isinstance(noise_models, Mapping) or set(noise_models) - set(names):
-            raise ValueError(f"noise_models must be a dict camera name -> noise model name for cameras {names}, "
-                             f"got {noise_models!r}")
+            raise ValueError(f"noise_models must be a dict camera name -> noise model name or NoiseEstimate for "
+                             f"cameras {names}, got {noise_models!r}")
         self.noise_models = {}
         for cam in self.cameras:
             preset = _preset_of(cam)
             model = noise_models.get(cam.name, preset.noise if preset is not None else DEFAULT_NOISE_MODEL)
-            depth_std_coefficients(model)  # raises with the valid names
+            if not isinstance(model, NoiseEstimate):
+                depth_std_coefficients(model)  # raises with the valid names
             self.noise_models[cam.name] = model
         _check_coverage(spec, self.cameras, _max_ranges(self.cameras, max_range))
         self._camera_arrays()
@@ -473,7 +472,9 @@ class OccupancyGrid:
             self._offsets[c] = offset
             offset += cam.width * cam.height
             self._half_extents[c] = 0.5 * self.spec.cell * np.abs(pose[2, :3]).sum()
-            self._sigma_lut[c] = depth_std(lut_depths, self.noise_models[cam.name])
+            model = self.noise_models[cam.name]
+            measured = isinstance(model, NoiseEstimate)
+            self._sigma_lut[c] = model.std(lut_depths) if measured else depth_std(lut_depths, model)
         self._depth = np.empty(offset, np.float32)
 
     def depth_noise(self, depth_l, camera: str) -> np.ndarray:

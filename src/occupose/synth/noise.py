@@ -18,6 +18,7 @@ The random depth error of each model (one standard deviation at a distance) is
 from __future__ import annotations
 
 import inspect
+import math
 from typing import Callable
 
 import numpy as np
@@ -110,7 +111,8 @@ def structured_light_noise(depth, rng: np.random.Generator, *, fx: float | None 
 
 
 def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, edge_jump: float = 0.05,
-              dropout: float = 0.002, min_range: float = 0.5, max_range: float = 4.5) -> np.ndarray:
+              dropout: float = 0.002, min_range: float = 0.5, max_range: float = 4.5,
+              std_scale: float = 1.0) -> np.ndarray:
     """Time-of-flight depth: Gaussian noise, flying pixels at depth edges, dropouts.
 
     depth : (H, W) float, metres, 0 = no measurement
@@ -121,10 +123,13 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
     dropout : float in [0, 1], share of pixels randomly lost
     min_range, max_range : float, metres; true depths outside are not measured
         (defaults: Kinect v2, 0.5-4.5 m; the Azure Kinect NFOV unbinned mode is 0.5-3.86 m)
+    std_scale : float > 0, the random depth error as a multiple of the nominal one (real
+        ToF cameras on dark or slanted surfaces are several times noisier)
 
     A flying pixel mixes the two surfaces its footprint straddles: its depth moves a
     uniform random share of the way towards the neighbour most different from it. Every
-    measured pixel then gets Gaussian noise of ``occupose.sensors.depth_std(z, "tof")``. Returns (H, W) float32.
+    measured pixel then gets Gaussian noise of ``std_scale * occupose.sensors.depth_std(z, "tof")``.
+    Returns (H, W) float32.
     """
     z = _check_depth(depth)
     _check_rng(rng)
@@ -133,9 +138,11 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
     _check_range(min_range, max_range)
     if not edge_jump > 0:
         raise ValueError(f"edge_jump must be > 0 metres, got {edge_jump!r}")
+    if not (math.isfinite(std_scale) and std_scale > 0):
+        raise ValueError(f"std_scale must be a finite number > 0, got {std_scale!r}")
     out = np.empty(z.shape, np.float32)
     _kernels.tof_pixels(z, rng, flying_fraction, float(edge_jump), float(min_range), float(max_range),
-                        depth_std_coefficients("tof"), out)
+                        float(std_scale) * depth_std_coefficients("tof"), out)
     return _drop(out, rng, dropout)
 
 
