@@ -96,7 +96,7 @@ def frames(scenario: Scenario, seed: int = 0, num_frames: int | None = None,
             full = render_camera(concat(bodies), cam, background=bg)
             rendered[cam.name] = full
             model, options = scenario.noise[cam.name]
-            depth[cam.name] = apply_noise(full.depth, model, rng, fx=cam.fx, **options)
+            depth[cam.name] = apply_noise(full.depth, model, rng, fx=cam.fx, person=full.person, **options)
             for i, body in enumerate(bodies):
                 alone = _alone_counts(body, cam)
                 seen = _part_counts(full, i + 1)
