@@ -39,6 +39,7 @@ from occupose.camera import CAMERA_PRESETS, Camera, look_at, sensor_spec
 from occupose.geometry.primitives import Primitives, concat
 from occupose.io.mocap import canonical_from_clip, list_clips, load_clip
 from occupose.joints import JOINT_INDEX as J
+from occupose.paths import mocap_dir
 from occupose.synth import motion as pm
 from occupose.synth import placement
 from occupose.synth.anthropometry import Anthropometry, draw_anthropometry
@@ -247,11 +248,16 @@ def _content(path: Path) -> str:
     return CMU_CONTENT.get(path.stem, path.stem.split("_")[1] if path.stem.startswith("dataset-") else path.stem)
 
 
-@functools.lru_cache(maxsize=1)
 def _clips_by_family() -> dict[str, tuple[Path, ...]]:
     """The shared clips by family (each CMU take once, its BVH preferred); {} without them."""
+    return _clips_under(mocap_dir())
+
+
+@functools.lru_cache(maxsize=4)
+def _clips_under(root: Path | None) -> dict[str, tuple[Path, ...]]:
+    """:func:`_clips_by_family` for the mocap folder ``root`` (None: no clips)."""
     takes: dict[str, Path] = {}
-    for path in list_clips():
+    for path in list_clips() if root is not None else []:
         if path.stem not in takes or path.suffix == ".bvh":
             takes[path.stem] = path
     families: dict[str, list[Path]] = {}
@@ -493,14 +499,16 @@ def _place_person(rng: np.random.Generator, view: _View, start: str, body: Anthr
             xy = spot + toward * (gap + _DEPTH[kind] / 2)
             new_furniture = _draw_furniture(rng, kind, tuple(xy), math.atan2(toward[1], toward[0]))
         occluder = furniture.get("prims", new_furniture)
-        seen = placement.in_view(joints[lead_frames if start == "walk_in" else 0:], view.camera, view.near, view.far)
+        checked = min(lead_frames, frames - 1) if start == "walk_in" else 0  # a short scene: its last frame
+        seen = placement.in_view(joints[checked:], view.camera, view.near, view.far)
         if seen.mean() < IN_VIEW_SHARE:
             continue
         obstacles = [p for p in [occluder] + [o.seat for o in others] if p is not None]
         if obstacles and np.any(placement.inside_boxes(joints.reshape(-1, 3), concat(obstacles), FURNITURE_MARGIN)):
             continue
         if seat is not None and (
-                any(np.any(placement.inside_boxes(o.joints.reshape(-1, 3), seat, FURNITURE_MARGIN)) for o in others)
+                np.any(placement.inside_boxes(joints.reshape(-1, 3), seat))  # walking through one's own seat
+                or any(np.any(placement.inside_boxes(o.joints.reshape(-1, 3), seat, FURNITURE_MARGIN)) for o in others)
                 or (obstacles and np.any(placement.inside_boxes(placement.box_corners(seat), concat(obstacles))))):
             continue
         if not placement.clear_of_people(joints, [o.joints for o in others], MIN_PELVIS_GAP, MIN_JOINT_GAP):
