@@ -24,8 +24,8 @@ FRAMES = 40
 
 @pytest.fixture(scope="module")
 def scenes():
-    """Random scenes of seeds 0..59, procedural motion, 40 frames each."""
-    return [rs.random_scenario(seed, use_mocap=False, frames=FRAMES) for seed in range(60)]
+    """Random scenes of seeds 0..29, procedural motion, 40 frames each."""
+    return [rs.random_scenario(seed, use_mocap=False, frames=FRAMES) for seed in range(30)]
 
 
 def _arrays(scenario):
@@ -50,11 +50,12 @@ def test_same_seed_same_scene_other_seeds_differ():
 
 def test_camera_draws_stay_in_their_ranges():
     rng = np.random.default_rng(np.random.SeedSequence(0))
-    views = [rs._draw_view(rng, None) for _ in range(200)]
+    designs = [rs._draw_design(rng, False, None) for _ in range(200)]
+    assert 0.25 < np.mean([d["view"] == "top" for d in designs]) < 0.45
+    assert {d["preset"] for d in designs} == set(CAMERA_PRESETS) and {d["count"] for d in designs} == {1, 2, 3}
+    views = [rs._draw_view(rng, d["preset"], d["view"]) for d in designs]
     front = [v for v in views if v.view == "front"]
     top = [v for v in views if v.view == "top"]
-    assert 0.25 < len(top) / len(views) < 0.45
-    assert {v.preset for v in views} == set(CAMERA_PRESETS)
     assert all(0.8 <= v.height <= 2.6 and 0.0 <= v.tilt <= 40.0 for v in front)
     assert all(2.5 <= v.height <= 3.5 for v in top)
     # the drawn tilt is the camera's: its optical axis points that far below the horizon
@@ -159,7 +160,7 @@ def test_without_the_shared_data_motion_is_procedural(monkeypatch, tmp_path):
 
 def test_with_mocap_every_family_is_drawn(mocap):
     families = {}
-    for seed in range(40):
+    for seed in range(25):
         for p in rs.random_scenario(seed, frames=FRAMES).conditions["persons"]:
             families.setdefault(p["motion"], set()).add(p["action"])
     assert set(families) >= {"walk", "gesture", "bow", "fight", "procedural"}
@@ -180,13 +181,17 @@ def test_names_suites_and_errors():
 
 
 def test_render_and_track_a_random_scene(tmp_path):
+    # random-3 (procedural): front view, one person partly hidden behind a counter from the
+    # first frame; the tracker starts on it within 20 frames (many random scenes it does not)
+    seed = 3
     runner = CliRunner()
     rec = tmp_path / "rec"
-    result = runner.invoke(main, ["synth", "random", str(rec), "--seed", "5", "--frames", "12", "--procedural"])
+    result = runner.invoke(main, ["synth", "random", str(rec), "--seed", str(seed), "--frames", "20", "--procedural"])
     assert result.exit_code == 0, result.output
     scene = json.loads((rec / "scene.json").read_text())
-    assert scene["name"] == "random-5" and scene["conditions"]["people"] >= 1
-    assert scene["conditions"] == rs.random_scenario(5, use_mocap=False).conditions
+    assert scene["name"] == f"random-{seed}" and scene["frames"] == 20
+    assert scene["conditions"]["start"] == "hidden" and scene["conditions"]["furniture"] == "counter"
+    assert scene["conditions"] == rs.random_scenario(seed, use_mocap=False).conditions
     result = runner.invoke(main, ["track", str(rec), "--out", str(tmp_path / "run")])
     assert result.exit_code == 0, result.output
     lines = (tmp_path / "run" / "tracks.csv").read_text().splitlines()

@@ -43,7 +43,7 @@ from occupose.paths import mocap_dir
 from occupose.synth import motion as pm
 from occupose.synth import placement
 from occupose.synth.anthropometry import Anthropometry, draw_anthropometry
-from occupose.synth.retarget import place, resample, retarget_lengths
+from occupose.synth.retarget import facing_from_joints, place, resample, retarget_lengths
 from occupose.synth.scenarios import FPS, Person, Scenario
 from occupose.synth.scene import cabinet, chair, couch, counter, room, shelf, table
 from occupose.synth.sequence import chain
@@ -96,6 +96,9 @@ FURNITURE_MARGIN = 0.08
 PEOPLE_WEIGHTS = {1: 0.5, 2: 0.3, 3: 0.2}
 #: Start modes (uniform for the first person; later people walk in or stand still).
 START_MODES = ("walk_in", "still", "hidden")
+#: Start "hidden": the share of the first person's joints whose line of sight from the
+#: camera crosses the furniture in the first frame (partly hidden: the upper body stays seen).
+HIDDEN_SHARE = (0.15, 0.6)
 #: Standing still before moving (starts "still" and "hidden"), seconds (uniform).
 STILL_RANGE = (0.5, 1.5)
 #: Walking in: speed in m/s, and the walk's length in metres (uniform).
@@ -113,10 +116,12 @@ MIN_PELVIS_GAP = 0.7
 MIN_JOINT_GAP = 0.25
 #: Mocap clips move the pelvis at most this far from where they start, metres (longer
 #: clips are cut and their last pose held).
-MAX_CLIP_TRAVEL = 2.5
-#: Placements tried per person before the whole scene is drawn again, and scene draws.
+MAX_CLIP_TRAVEL = 3.0
+#: Placements tried per person before the scene's geometry is drawn again; geometry draws
+#: per design (:func:`_draw_design`), and designs drawn before giving up.
 PLACEMENT_TRIES = 40
-SCENE_TRIES = 30
+SCENE_TRIES = 20
+DESIGN_TRIES = 10
 
 #: Mocap clip families (by the clip's content label) and the weight of each, with the
 #: procedural sitting (always procedural: no clip sits down).
@@ -190,20 +195,19 @@ class _View:
     far: float
 
 
-def _draw_view(rng: np.random.Generator, sensor: str | None) -> _View:
-    presets = sorted(CAMERA_PRESETS)
-    preset = presets[rng.integers(len(presets))]
-    preset = sensor or preset
+def _draw_view(rng: np.random.Generator, preset: str, view: str) -> _View:
+    """The camera of a ``view`` ("front" | "top") scene: intrinsics of ``preset``
+    jittered, height and tilt drawn."""
     spec = sensor_spec(preset)
     fx, fy = (f * (1.0 + rng.uniform(-FOCAL_JITTER, FOCAL_JITTER)) for f in (spec.fx, spec.fy))
     cx = spec.cx + rng.uniform(-PRINCIPAL_JITTER, PRINCIPAL_JITTER) * spec.width
     cy = spec.cy + rng.uniform(-PRINCIPAL_JITTER, PRINCIPAL_JITTER) * spec.height
-    if rng.random() < TOP_SHARE:
-        view, height, tilt = "top", float(rng.uniform(*TOP_HEIGHT_RANGE)), 90.0
+    if view == "top":
+        height, tilt = float(rng.uniform(*TOP_HEIGHT_RANGE)), 90.0
         yaw = rng.uniform(-math.pi, math.pi)
         pose = look_at((0.0, 0.0, height), (0.0, 0.0, 0.0), up=(math.cos(yaw), math.sin(yaw), 0.0))
     else:
-        view, height, tilt = "front", float(rng.uniform(*FRONT_HEIGHT_RANGE)), float(rng.uniform(*FRONT_TILT_RANGE))
+        height, tilt = float(rng.uniform(*FRONT_HEIGHT_RANGE)), float(rng.uniform(*FRONT_TILT_RANGE))
         t = math.radians(tilt)
         pose = look_at((0.0, 0.0, height), (0.0, math.cos(t), height - math.sin(t)))
     camera = Camera(name=view, width=spec.width, height=spec.height, fx=float(fx), fy=float(fy), cx=float(cx),
@@ -290,19 +294,25 @@ def _draw_gestures(rng: np.random.Generator) -> list[tuple]:
     return out
 
 
-def _draw_plan(rng: np.random.Generator, use_mocap: bool) -> _Plan:
+def _draw_family(rng: np.random.Generator, use_mocap: bool) -> str:
+    """A person's motion: a clip family or "sit" (:data:`FAMILY_WEIGHTS`) when the clips
+    are there, else a procedural action (:data:`PROCEDURAL_ACTIONS`)."""
     clips = _clips_by_family() if use_mocap else {}
+    if not clips:
+        return PROCEDURAL_ACTIONS[rng.integers(len(PROCEDURAL_ACTIONS))]
+    families = [f for f in FAMILY_WEIGHTS if f == "sit" or f in clips]
+    weights = np.array([FAMILY_WEIGHTS[f] for f in families])
+    return families[rng.choice(len(families), p=weights / weights.sum())]
+
+
+def _draw_plan(rng: np.random.Generator, family: str, use_mocap: bool) -> _Plan:
+    """A motion of ``family`` (:func:`_draw_family`): a clip of it, or (no clips, or
+    ``use_mocap`` False) the procedural action of that name."""
+    clips = _clips_by_family().get(family, ()) if use_mocap else ()
     if clips:
-        families = [f for f in FAMILY_WEIGHTS if f == "sit" or f in clips]
-        weights = np.array([FAMILY_WEIGHTS[f] for f in families])
-        family = families[rng.choice(len(families), p=weights / weights.sum())]
-        if family != "sit":
-            paths = clips[family]
-            path = paths[rng.integers(len(paths))]
-            return _Plan(family, path.stem, path, float(rng.uniform(0.0, 0.5)))
-        action = "sit"
-    else:
-        action = PROCEDURAL_ACTIONS[rng.integers(len(PROCEDURAL_ACTIONS))]
+        path = clips[rng.integers(len(clips))]
+        return _Plan(family, path.stem, path, float(rng.uniform(0.0, 0.5)))
+    action = family
     params: dict = {"gestures": _draw_gestures(rng)}
     if action == "walk":
         params.update(distance=float(rng.uniform(1.2, 2.5)), turn=float(rng.uniform(-1.0, 1.0)),
@@ -429,9 +439,25 @@ def _draw_spot(rng: np.random.Generator, view: _View) -> np.ndarray:
     return np.array([rng.uniform(-1.0, 1.0) * 0.75 * math.tan(half) * depth, depth])
 
 
+def _travel_angle(plan: _Plan) -> float:
+    """Direction a clip travels in relative to the way it faces at its start, radians
+    (its first 3 s from where the plan starts it)."""
+    clip = _clip_joints(plan.clip)
+    first = int(plan.start * max(len(clip) - 30, 0))
+    pelvis = clip[first:first + 90, J["pelvis"], :2]
+    way = pelvis[-1] - pelvis[0]
+    return math.atan2(way[1], way[0]) - float(facing_from_joints(clip[first]))
+
+
 def _draw_heading(rng: np.random.Generator, view: _View, spot: np.ndarray, plan: _Plan) -> float:
-    if view.view == "top" or plan.family in ("walk", "run"):
+    """Where the person faces when the plan starts: towards a front camera within
+    +-:data:`FACING_SPREAD_DEG`, any way under a top camera; a walk or run clip in a front
+    view travels across the image (within 30 degrees of its horizontal)."""
+    if view.view == "top":
         return float(rng.uniform(-math.pi, math.pi))
+    if plan.family in ("walk", "run"):
+        across = (0.0 if rng.random() < 0.5 else math.pi) + math.radians(rng.uniform(-30.0, 30.0))
+        return across - _travel_angle(plan)
     d = view.camera.world_from_camera[:2, 3] - spot
     return math.atan2(d[1], d[0]) + math.radians(rng.uniform(-FACING_SPREAD_DEG, FACING_SPREAD_DEG))
 
@@ -473,19 +499,23 @@ def _seat(rng: np.random.Generator, plan: _Plan, spot: np.ndarray, heading: floa
     return couch(tuple(xy), heading, width=float(rng.uniform(1.6, 2.0)), seat_height=plan.params["seat_height"])
 
 
-def _place_person(rng: np.random.Generator, view: _View, start: str, body: Anthropometry, use_mocap: bool,
-                  frames: int, furniture: dict, others: list[_Placed]) -> _Placed:
-    """Draw a plan and a spot until the person fits (module docstring); ``furniture`` holds
-    ``kind`` and, once placed (by the first person), ``prims``."""
+def _place_person(rng: np.random.Generator, view: _View, start: str, body: Anthropometry, family: str,
+                  use_mocap: bool, frames: int, furniture: dict, others: list[_Placed]) -> _Placed:
+    """Draw a motion of ``family`` and a spot until the person fits (module docstring);
+    ``furniture`` holds ``kind`` and, once placed (by the first person), ``prims``."""
     for attempt in range(PLACEMENT_TRIES):
         if attempt % 10 == 0:
-            plan = _draw_plan(rng, use_mocap)
+            plan = _draw_plan(rng, family, use_mocap)
         spot = _draw_spot(rng, view)
         heading = _draw_heading(rng, view, spot, plan)
         if plan.action == "sit" and view.view == "front":  # sitting faces the camera within 25 degrees
             d = view.camera.world_from_camera[:2, 3] - spot
             heading = math.atan2(d[1], d[0]) + math.radians(rng.uniform(-25.0, 25.0))
         lead = _draw_lead(rng, view, start, spot)
+        dims = body.motion_dims()
+        standing = pm.joints_from_procedural(pm.stance(spot, heading, dims)[None], dims)
+        if not placement.in_view(standing, view.camera, view.near, view.far)[0]:
+            continue  # a quick test first: someone standing at the spot must be in view
         try:
             joints, lead_frames = _trajectory(plan, body, spot, heading, start, lead, frames)
         except ValueError:  # e.g. a seat too high or low for this body
@@ -515,7 +545,7 @@ def _place_person(rng: np.random.Generator, view: _View, start: str, body: Anthr
             continue
         if start == "hidden":
             hidden = placement.hidden_from(view.camera, joints[0], occluder).mean()
-            if not 0.15 <= hidden <= 0.85:
+            if not HIDDEN_SHARE[0] <= hidden <= HIDDEN_SHARE[1]:
                 continue
         if new_furniture is not None:
             furniture["prims"] = new_furniture
@@ -551,18 +581,32 @@ def _room(rng: np.random.Generator, view: _View, occupied: np.ndarray) -> tuple[
     return prims, record
 
 
-def _draw_scene(rng: np.random.Generator, seed: int, use_mocap: bool, frames: int, sensor: str | None) -> Scenario:
-    view = _draw_view(rng, sensor)
+def _draw_design(rng: np.random.Generator, use_mocap: bool, sensor: str | None) -> dict:
+    """The scene's categorical draws: camera preset and view, people, their start modes and
+    motion families, the furniture kind. They are kept while the geometry is drawn again,
+    so that placing a person does not favour the motions and views that are easy to place."""
+    presets = sorted(CAMERA_PRESETS)
+    preset = presets[rng.integers(len(presets))]
+    view = "top" if rng.random() < TOP_SHARE else "front"
     counts = list(PEOPLE_WEIGHTS)
     count = counts[rng.choice(len(counts), p=np.array(list(PEOPLE_WEIGHTS.values())))]
     start = START_MODES[rng.integers(len(START_MODES))]
+    starts = [start] + [("walk_in", "still")[rng.integers(2)] for _ in range(count - 1)]
     kinds = FURNITURE_KINDS[1:] if start == "hidden" else FURNITURE_KINDS
-    furniture = {"kind": kinds[rng.integers(len(kinds))]}
+    return {"preset": sensor or preset, "view": view, "count": count, "starts": starts, "use_mocap": use_mocap,
+            "families": [_draw_family(rng, use_mocap) for _ in range(count)],
+            "furniture": kinds[rng.integers(len(kinds))]}
+
+
+def _draw_scene(rng: np.random.Generator, seed: int, design: dict, frames: int) -> Scenario:
+    view = _draw_view(rng, design["preset"], design["view"])
+    count, start = design["count"], design["starts"][0]
+    furniture = {"kind": design["furniture"]}
     placed: list[_Placed] = []
     for i in range(count):
         body = draw_anthropometry(rng)
-        own_start = start if i == 0 else ("walk_in", "still")[rng.integers(2)]
-        placed.append(_place_person(rng, view, own_start, body, use_mocap, frames, furniture, placed))
+        placed.append(_place_person(rng, view, design["starts"][i], body, design["families"][i],
+                                    design["use_mocap"], frames, furniture, placed))
     dark = tuple(i + 1 for i in range(count) if rng.random() < DARK_SHARE)
     people = tuple(Person(p.joints, p.body.body_shape(rng, "dark" if i + 1 in dark else "normal"))
                    for i, p in enumerate(placed))
@@ -622,12 +666,14 @@ def random_scenario(seed: int, use_mocap: bool = True, frames: int | None = None
     if sensor is not None:
         sensor_spec(sensor)
     rng = np.random.default_rng(np.random.SeedSequence(int(seed)))
-    for _ in range(SCENE_TRIES):
-        try:
-            return _draw_scene(rng, int(seed), use_mocap, int(frames), sensor)
-        except _Redraw:
-            continue
-    raise RuntimeError(f"random scene {seed}: no placement found in {SCENE_TRIES} draws")
+    for _ in range(DESIGN_TRIES):
+        design = _draw_design(rng, use_mocap, sensor)
+        for _ in range(SCENE_TRIES):
+            try:
+                return _draw_scene(rng, int(seed), design, int(frames))
+            except _Redraw:
+                continue
+    raise RuntimeError(f"random scene {seed}: no placement found in {DESIGN_TRIES} x {SCENE_TRIES} draws")
 
 
 __all__ = ["DEFAULT_FRAMES", "PREFIX", "is_random_name", "random_scenario", "seed_of", "suite"]
