@@ -84,7 +84,13 @@ def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: st
 @click.option("--procedural", is_flag=True, help="Use the built-in procedural motion even when real mocap clips are present.")
 @click.option("--force", is_flag=True, help="Replace OUT if it exists.")
 def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
-    """Render the synthetic scenario NAME into the recording folder OUT."""
+    """Render the synthetic scenario NAME into the recording folder OUT.
+
+    NAME is a scenario of the catalogue (`occupose scenarios`), "random" (the random scene
+    of --seed) or random-<seed>; a random scene's conditions go to OUT/scene.json.
+    """
+    if name == "random":
+        name = f"random-{seed}"
     _write_synth(name, out, seed, frames, sensor, force, procedural)
 
 
@@ -311,7 +317,10 @@ def demo_cmd(out, scenario, frames, method) -> None:
 
 
 @main.command("evaluate")
-@click.option("--scenarios", default=None, help="Scenarios, comma-separated (default: the whole catalogue; see `occupose scenarios`).")
+@click.option("--scenarios", default=None, help="Scenarios, comma-separated: catalogue names (see `occupose scenarios`) "
+              "or random-<seed> (default: the whole catalogue).")
+@click.option("--suite", default=None, help="A whole suite instead of --scenarios: catalogue, or random:N "
+              "(the random scenes of seeds 0..N-1).")
 @click.option("--methods", default="ours,apf,ps", show_default=True, help="Methods, comma-separated (ours, apf, ps, part-based).")
 @click.option("--runs", type=click.IntRange(min=1), default=3, show_default=True, help="Runs per method and scenario (seeds 0..runs-1).")
 @click.option("--frames", type=click.IntRange(min=1), default=None, help="At most N frames of each scenario.")
@@ -319,9 +328,9 @@ def demo_cmd(out, scenario, frames, method) -> None:
 @click.option("--jobs", type=click.IntRange(min=1), default=None, help="Worker processes (default: one per core; 1: no workers).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
               help="Folder for recordings/, runs/, results.csv, report.md and the plots (recordings are reused).")
-def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> None:
+def evaluate_cmd(scenarios, suite, methods, runs, frames, procedural, jobs, out) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
-    from occupose.evaluation.evaluate import evaluate
+    from occupose.evaluation.evaluate import evaluate, suite_scenarios
     from occupose.evaluation.report import table_i_markdown, table_rows
 
     bars = []  # opened at the first report, once evaluate has checked its input and knows the total
@@ -331,7 +340,11 @@ def evaluate_cmd(scenarios, methods, runs, frames, procedural, jobs, out) -> Non
             bars.append(_progress_bar(total, "evaluating"))
         bars[0].update(n)
 
+    if suite is not None and scenarios is not None:
+        _fail("give --scenarios or --suite, not both")
     try:
+        if suite is not None:
+            scenarios = suite_scenarios(suite)
         result = evaluate(scenarios, methods, runs, out=out, frames=frames, procedural=procedural,
                           jobs=jobs, progress=progress)
     except (ValueError, FileNotFoundError) as error:

@@ -218,3 +218,37 @@ def test_bad_input_is_rejected():
         apply_noise(np.full((3, 3), np.nan), "none", rng)
     with pytest.raises(ValueError, match="dropout"):
         apply_noise(wall, "tof", rng, dropout=1.5)
+
+
+# --- errors beyond the nominal models (the randomized scenes' worse sensors) ---------------
+
+def test_sensor_errors_add_noise_bias_and_patchy_dropouts_on_dark_people():
+    rng = np.random.default_rng(3)
+    depth = np.full((240, 320), 2.0)
+    depth[:, :10] = 0.0                                  # no measurement stays none
+    person = np.zeros(depth.shape, np.uint16)
+    person[40:200, 100:180] = 1                          # a dark person
+    person[40:200, 200:280] = 2                          # and one in other clothes
+    out = apply_noise(depth, "none", rng, person=person, extra_std=0.01, bias=0.011, bias_scale=0.001,
+                      body_dropout=0.3, dark_people=(1,))
+    assert np.all(out[:, :10] == 0)
+    other = out[person == 2]
+    assert np.all(other > 0)
+    assert other.mean() == pytest.approx(2.0 + 0.011 + 0.002, abs=1e-3)
+    assert other.std() == pytest.approx(0.01, rel=0.05)
+    dark = out[40:200, 100:180]
+    assert np.mean(dark == 0) == pytest.approx(0.3, abs=0.01)
+    # in patches: a lost pixel's right neighbour is lost far more often than 30 % of the time
+    lost = dark == 0
+    assert np.mean(lost[:, 1:][lost[:, :-1]]) > 0.8
+
+
+def test_sensor_errors_default_to_nothing_and_refuse_bad_options():
+    depth = np.full((20, 30), 1.5)
+    plain = apply_noise(depth, "tof", np.random.default_rng(1))
+    same = apply_noise(depth, "tof", np.random.default_rng(1), extra_std=0.0, bias=0.0, body_dropout=0.0)
+    assert np.array_equal(plain, same)
+    with pytest.raises(ValueError, match="body_dropout needs the person image"):
+        apply_noise(depth, "none", np.random.default_rng(1), body_dropout=0.2, dark_people=(1,))
+    with pytest.raises(ValueError, match="extra_std must be >= 0"):
+        apply_noise(depth, "none", np.random.default_rng(1), extra_std=-0.01)

@@ -52,3 +52,29 @@ def test_resample_is_exact_on_linear_motion(rng):
     np.testing.assert_allclose(up, np.arange(46)[:, None, None] / 45.0 * v + joints[0], atol=1e-12)
     with pytest.raises(ValueError, match="positive"):
         rt.resample(joints, 0.0, 30.0)
+
+
+def test_retarget_lengths_gives_the_new_bones_and_keeps_their_directions():
+    from occupose.joints import BONES
+
+    rng = np.random.default_rng(0)
+    t = np.linspace(0, 1, 40)
+    skeleton = np.array([[0, 0, 1.62], [0, 0, 1.5], [0, 0, 0.92], [0.18, 0, 1.44], [0.2, 0.05, 1.15], [0.22, 0.1, 0.9],
+                         [-0.18, 0, 1.44], [-0.2, 0.05, 1.15], [-0.22, 0.1, 0.9], [0.095, 0, 0.92], [0.1, 0.02, 0.5],
+                         [0.1, 0, 0.08], [-0.095, 0, 0.92], [-0.1, 0.02, 0.5], [-0.1, 0, 0.08]])
+    joints = skeleton[None] + 0.02 * rng.standard_normal((40, 15, 3))
+    joints[:, :, 0] += 1.2 * t[:, None]                                  # walks 1.2 m along x
+    target = rng.uniform(0.1, 0.5, len(BONES))
+    out = rt.retarget_lengths(joints, target)
+    assert np.allclose(bone_lengths(out), target[None])
+    for a, b in BONES:
+        old, new = joints[:, b] - joints[:, a], out[:, b] - out[:, a]
+        cos = np.sum(old * new, axis=-1) / np.linalg.norm(old, axis=-1) / np.linalg.norm(new, axis=-1)
+        assert np.all(cos > 1 - 1e-9)
+    legs = [i for i, (a, b) in enumerate(BONES) if {a, b} & {J["left_knee"], J["right_knee"]}]
+    ratio = target[legs].sum() / np.median(bone_lengths(joints)[:, legs], axis=0).sum()
+    travel = out[-1, J["pelvis"], 0] - out[0, J["pelvis"], 0]
+    assert travel == pytest.approx(ratio * (joints[-1, J["pelvis"], 0] - joints[0, J["pelvis"], 0]))
+    assert out[:30, [J["left_ankle"], J["right_ankle"]], 2].min() == pytest.approx(ANKLE_HEIGHT)
+    with pytest.raises(ValueError, match="bone_lengths must be 14 positive"):
+        rt.retarget_lengths(joints, target[:5])

@@ -72,20 +72,38 @@ class Evaluation:
 # --------------------------------------------------------------------------- checks
 
 
-def _names(given: Sequence[str] | str | None, valid: Sequence[str], default: Sequence[str], what: str) -> list[str]:
-    """Checked list of names (a comma-separated string or a sequence; None: ``default``)."""
+def _names(given: Sequence[str] | str | None, valid: Sequence[str], default: Sequence[str], what: str,
+           also: Callable[[str], bool] | None = None, also_text: str = "") -> list[str]:
+    """Checked list of names (a comma-separated string or a sequence; None: ``default``).
+
+    also : names it accepts besides ``valid`` (``also_text`` says which, in the error)."""
     if given is None:
         return list(default)
     names = [n.strip() for n in given.split(",")] if isinstance(given, str) else [str(n) for n in given]
     names = [n for n in names if n]
     if not names:
         raise ValueError(f"no {what} given; valid names: {', '.join(valid)}")
-    unknown = [n for n in names if n not in valid]
+    unknown = [n for n in names if n not in valid and not (also is not None and also(n))]
     if unknown:
-        raise ValueError(f"unknown {what} {', '.join(map(repr, unknown))}; valid names: {', '.join(valid)}")
+        raise ValueError(f"unknown {what} {', '.join(map(repr, unknown))}; valid names: {', '.join(valid)}"
+                         + (f", {also_text}" if also_text else ""))
     if len(set(names)) != len(names):
         raise ValueError(f"{what} named twice: {names}")
     return names
+
+
+def suite_scenarios(suite: str) -> list[str]:
+    """The scenario names of a suite: ``"catalogue"`` (every scenario of the catalogue) or
+    ``"random:N"`` (the random scenes of seeds 0..N-1, ``random-0`` ... ``random-<N-1>``)."""
+    from occupose.synth.random_scenes import suite as random_suite
+    from occupose.synth.scenarios import SCENARIOS
+
+    kind, _, count = str(suite).partition(":")
+    if kind == "catalogue" and not count:
+        return list(SCENARIOS)
+    if kind == "random" and count.isdigit() and int(count) >= 1:
+        return random_suite(int(count))
+    raise ValueError(f"unknown suite {suite!r}; valid: catalogue, random:N (N >= 1 scenes, seeds 0..N-1)")
 
 
 # --------------------------------------------------------------------------- tasks (run in workers)
@@ -93,7 +111,8 @@ def _names(given: Sequence[str] | str | None, valid: Sequence[str], default: Seq
 
 def render_recording(scenario: str, out: Path, frames: int | None, procedural: bool,
                      progress: Callable[[int], None] | None = None) -> Path:
-    """Render ``scenario`` (scene seed SCENE_SEED) into the recording folder ``out``, or
+    """Render ``scenario`` (scene seed SCENE_SEED; a random scene ``random-<N>``: noise
+    seed N) into the recording folder ``out``, or
     keep the one already there when it was rendered with the same settings and the same
     ground-truth motion (occupose.synth.catalogue, policy "reuse").
 
@@ -101,12 +120,14 @@ def render_recording(scenario: str, out: Path, frames: int | None, procedural: b
     An existing folder rendered differently (or half-written) is replaced.
     """
     from occupose.synth.catalogue import render_scenario
+    from occupose.synth.random_scenes import is_random_name, seed_of
 
     def report(done: int, total: int) -> None:
         if done:
             progress(done)
 
-    return render_scenario(scenario, out, seed=SCENE_SEED, frames=frames, procedural=procedural, exists="reuse",
+    seed = seed_of(scenario) if is_random_name(scenario) else SCENE_SEED
+    return render_scenario(scenario, out, seed=seed, frames=frames, procedural=procedural, exists="reuse",
                            clip_frames=True, progress=None if progress is None else report).path
 
 
@@ -221,7 +242,8 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
              overrides: Mapping[str, Any] | None = None) -> Evaluation:
     """Run every method on every scenario ``runs`` times (seeds 0..runs-1) and report.
 
-    scenarios : names of occupose.synth.scenarios.SCENARIOS (a list or "a,b"); None: all
+    scenarios : names of occupose.synth.scenarios.SCENARIOS or random scenes ``random-<seed>``
+        (a list or "a,b"; :func:`suite_scenarios` names whole suites); None: the catalogue
     methods : names of occupose.config.METHODS; None: DEFAULT_METHODS
     runs : runs per method and scenario, >= 1
     out : folder for recordings/, runs/, results.csv, report.md and the plots
@@ -235,10 +257,12 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
 
     Returns an Evaluation. Raises ValueError for unknown names or bad counts.
     """
+    from occupose.synth.random_scenes import PREFIX, is_random_name
     from occupose.synth.scenarios import SCENARIOS, build_scenario
     from occupose.config import METHODS
 
-    scenarios = _names(scenarios, list(SCENARIOS), list(SCENARIOS), "scenario(s)")
+    scenarios = _names(scenarios, list(SCENARIOS), list(SCENARIOS), "scenario(s)", also=is_random_name,
+                       also_text=f"or {PREFIX}<seed>")
     methods = _names(methods, list(METHODS), DEFAULT_METHODS, "method(s)")
     runs = positive_int(runs, "runs")
     frames = None if frames is None else positive_int(frames, "frames")
@@ -317,4 +341,4 @@ def _drain(frames_done, progress) -> None:
         progress(count)
 
 
-__all__ = ["DEFAULT_METHODS", "Evaluation", "arm_points", "evaluate", "render_recording", "run_method"]
+__all__ = ["DEFAULT_METHODS", "Evaluation", "arm_points", "evaluate", "render_recording", "run_method", "suite_scenarios"]

@@ -70,6 +70,14 @@ def random_body_shape(rng: np.random.Generator, clothing: str = "normal") -> Bod
         "shin": (r(0.052), r(0.040)),
         "foot": np.array([r(0.125), r(0.045), 0.038]),         # half length, width, height
     }
+    return BodyShape(radii=radii, colors=clothing_colors(rng, clothing))
+
+
+def clothing_colors(rng: np.random.Generator, clothing: str = "normal") -> np.ndarray:
+    """Draw a skin tone and clothing colours of ``clothing`` style (:data:`CLOTHING_STYLES`):
+    (15, 3) uint8, albedo per part in the order of a BodyShape's ``colors``."""
+    if clothing not in CLOTHING_STYLES:
+        raise ValueError(f"unknown clothing style {clothing!r}; valid: {', '.join(CLOTHING_STYLES)}")
     skin = _SKIN_TONES[rng.integers(len(_SKIN_TONES))]
     if clothing == "flashy":
         top, sleeve, trousers, shoes = _FLASHY[rng.permutation(len(_FLASHY))[:4]]
@@ -87,8 +95,7 @@ def random_body_shape(rng: np.random.Generator, clothing: str = "normal") -> Bod
         "left_thigh": trousers, "left_shin": trousers, "left_foot": shoes,
         "right_thigh": trousers, "right_shin": trousers, "right_foot": shoes,
     }
-    colors = np.array([per_part[name] for name in _COLORED_PARTS], np.uint8)
-    return BodyShape(radii=radii, colors=colors)
+    return np.array([per_part[name] for name in _COLORED_PARTS], np.uint8)
 
 
 def _unit(v: np.ndarray, fallback: np.ndarray) -> np.ndarray:

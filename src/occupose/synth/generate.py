@@ -12,6 +12,7 @@ some camera's view, hidden or not; ground-truth rows are written only for presen
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +29,8 @@ from occupose.synth.render import Rendered, render_camera
 from occupose.synth.scenarios import Scenario
 
 MIN_PART_PIXELS = 4
+#: File of a synthetic recording that describes its scene (JSON; see :func:`write_scenario`).
+SCENE_FILE = "scene.json"
 
 
 @dataclass(frozen=True)
@@ -96,7 +99,7 @@ def frames(scenario: Scenario, seed: int = 0, num_frames: int | None = None,
             full = render_camera(concat(bodies), cam, background=bg)
             rendered[cam.name] = full
             model, options = scenario.noise[cam.name]
-            depth[cam.name] = apply_noise(full.depth, model, rng, fx=cam.fx, **options)
+            depth[cam.name] = apply_noise(full.depth, model, rng, fx=cam.fx, person=full.person, **options)
             for i, body in enumerate(bodies):
                 alone = _alone_counts(body, cam)
                 seen = _part_counts(full, i + 1)
@@ -113,7 +116,9 @@ def write_scenario(scenario: Scenario, out: str | Path, seed: int = 0, num_frame
 
     Besides depth, colour and ``groundtruth.csv``, the synthetic recording keeps the
     renderer's label images: ``<camera>/person/NNNNNN.png`` (8-bit person id, 0 = none)
-    and ``<camera>/part/NNNNNN.png`` (8-bit body-part label of :data:`occupose.joints.PARTS`).
+    and ``<camera>/part/NNNNNN.png`` (8-bit body-part label of :data:`occupose.joints.PARTS`),
+    and :data:`SCENE_FILE`: the scenario's name, description, motion source, events and
+    ``conditions`` (what a randomized scene drew), so runs can be bucketed by them.
     progress : optional callable ``progress(n)`` called after each frame.
     """
     out = Path(out)
@@ -134,4 +139,8 @@ def write_scenario(scenario: Scenario, out: str | Path, seed: int = 0, num_frame
             if progress is not None:
                 progress(1)
         writer.write_groundtruth(gt, vis, person_ids=list(range(1, num_people + 1)))
+    scene = {"name": scenario.name, "description": scenario.description, "frames": total,
+             "motion_source": scenario.motion_source, "events": {k: list(v) for k, v in scenario.events.items()},
+             "conditions": scenario.conditions}
+    (out / SCENE_FILE).write_text(json.dumps(scene, indent=1) + "\n")
     return out

@@ -11,6 +11,10 @@ pixels that were 0 stay 0, and a model may add invalid pixels of its own.
 - ``"tof"`` (time of flight, Kinect v2 / Azure Kinect): Gaussian depth noise, flying pixels
   at depth edges, random dropouts, a working range.
 
+Any model's entry may add :func:`sensor_errors` (extra random noise, a systematic bias,
+patchy dropouts on people in clothes of low reflectivity): the randomized scenes draw
+them from nominal up to a sensor's specified worst case.
+
 The random depth error of each model (one standard deviation at a distance) is
 :func:`occupose.sensors.depth_std`, the figure the occupancy grid uses as its tolerance.
 """
@@ -146,6 +150,66 @@ def tof_noise(depth, rng: np.random.Generator, *, flying_fraction: float = 0.5, 
     return _drop(out, rng, dropout)
 
 
+def sensor_errors(depth, rng: np.random.Generator, person=None, *, extra_std: float = 0.0, bias: float = 0.0,
+                  bias_scale: float = 0.0, body_dropout: float = 0.0, dark_people=(), patch: int = 6) -> np.ndarray:
+    """Errors beyond a sensor model's nominal ones, on an already noisy depth image.
+
+    depth : (H, W) float, metres, 0 = no measurement
+    rng : np.random.Generator (not used when every option is at its default)
+    person : (H, W) int person-id image of the same view (0 = scene); needed for ``body_dropout``
+    extra_std : metres, standard deviation of extra Gaussian noise on every measured pixel
+        (a sensor worse than its nominal model, up to its specified worst case)
+    bias, bias_scale : systematic depth error: every measured depth becomes
+        ``z + bias + bias_scale * z`` (metres, and a share of the depth); the same in every
+        frame of a camera, as a real sensor's calibration error is
+    body_dropout : share in [0, 1] of the pixels of ``dark_people`` lost, in patches:
+        clothes of low reflectivity return too little light for a time-of-flight or
+        structured-light measurement
+    dark_people : person ids wearing such clothes
+    patch : pixels, the size of the cells of the random field whose lowest values are dropped
+
+    Returns (H, W) float32 metres; pixels that were 0 stay 0.
+    """
+    z = _check_depth(depth)
+    _check_rng(rng)
+    body_dropout = _check_rate(body_dropout, "body_dropout")
+    if not (np.isfinite(extra_std) and extra_std >= 0.0):
+        raise ValueError(f"extra_std must be >= 0 metres, got {extra_std!r}")
+    if not (np.isfinite(bias) and np.isfinite(bias_scale) and abs(bias_scale) < 1.0):
+        raise ValueError(f"bias must be finite metres and |bias_scale| < 1, got {bias!r}, {bias_scale!r}")
+    measured = z > 0.0
+    if extra_std > 0.0:
+        z = np.where(measured, z + rng.normal(0.0, extra_std, z.shape), 0.0)
+    if bias or bias_scale:
+        z = np.where(measured, z + bias + bias_scale * z, 0.0)
+    if body_dropout > 0.0 and len(dark_people):
+        if person is None or np.shape(person) != z.shape:
+            raise ValueError(f"body_dropout needs the person image of the view, shape {z.shape}")
+        if not int(patch) >= 1:
+            raise ValueError(f"patch must be >= 1 pixel, got {patch!r}")
+        body = np.isin(person, list(dark_people)) & measured
+        if np.any(body):
+            field = _patch_field(z.shape, int(patch), rng)
+            z = np.where(body & (field <= np.quantile(field[body], body_dropout)), 0.0, z)
+    return np.maximum(z, 0.0).astype(np.float32)
+
+
+def _patch_field(shape: tuple[int, int], patch: int, rng: np.random.Generator) -> np.ndarray:
+    """(H, W) smooth random field: uniform values on a grid of ``patch``-pixel cells,
+    interpolated bilinearly."""
+    height, width = shape
+    grid = rng.random((height // patch + 2, width // patch + 2))
+    v, u = np.arange(height) / patch, np.arange(width) / patch
+    v0, u0 = v.astype(np.int64), u.astype(np.int64)
+    fv, fu = (v - v0)[:, None], (u - u0)[None, :]
+    top = grid[v0][:, u0] * (1 - fu) + grid[v0][:, u0 + 1] * fu
+    bottom = grid[v0 + 1][:, u0] * (1 - fu) + grid[v0 + 1][:, u0 + 1] * fu
+    return top * (1 - fv) + bottom * fv
+
+
+#: Options of every noise entry besides the model's own: :func:`sensor_errors`'s.
+SENSOR_ERROR_OPTIONS = ("extra_std", "bias", "bias_scale", "body_dropout", "dark_people", "patch")
+
 #: Noise models by name: each is ``f(depth, rng, **options) -> depth``.
 NOISE_MODELS: dict[str, Callable[..., np.ndarray]] = {
     "none": no_noise, "structured_light": structured_light_noise, "tof": tof_noise,
@@ -153,19 +217,22 @@ NOISE_MODELS: dict[str, Callable[..., np.ndarray]] = {
 
 
 def apply_noise(depth, model: str, rng: np.random.Generator, *, fx: float | None = None,
-                **options) -> np.ndarray:
+                person=None, **options) -> np.ndarray:
     """Apply the noise model registered as ``model`` to a depth image.
 
     depth : (H, W) float, metres, 0 = no measurement
     model : a key of NOISE_MODELS
     rng : np.random.Generator (the same seed gives the same image)
     fx : float, focal length in pixels, passed to the models that use it (structured light)
-    options : the model's own keyword options (see its function)
+    person : (H, W) person-id image of the view, for the ``body_dropout`` option
+    options : the model's own keyword options (see its function) and those of
+        :data:`SENSOR_ERROR_OPTIONS` (:func:`sensor_errors`, applied after the model when given)
 
     Returns (H, W) float32 metres, 0 = no measurement.
     """
     if model not in NOISE_MODELS:
         raise ValueError(f"unknown noise model {model!r}; valid names: {sorted(NOISE_MODELS)}")
+    errors = {name: options.pop(name) for name in SENSOR_ERROR_OPTIONS if name in options}
     function = NOISE_MODELS[model]
     accepted = [name for name, p in inspect.signature(function).parameters.items()
                 if p.kind is inspect.Parameter.KEYWORD_ONLY]
@@ -174,4 +241,5 @@ def apply_noise(depth, model: str, rng: np.random.Generator, *, fx: float | None
         raise ValueError(f"noise model {model!r} has no option(s) {unknown}; its options: {accepted}")
     if "fx" in accepted:
         options["fx"] = fx
-    return function(depth, rng, **options)
+    out = function(depth, rng, **options)
+    return sensor_errors(out, rng, person, **errors) if errors else out

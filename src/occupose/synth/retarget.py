@@ -15,7 +15,7 @@ import numpy as np
 
 from occupose._validate import joints_array
 from occupose.io.mocap import ANKLE_HEIGHT
-from occupose.joints import JOINT_INDEX
+from occupose.joints import BONES, JOINT_INDEX
 
 
 def resample(joints, fps_in: float, fps_out: float) -> np.ndarray:
@@ -78,4 +78,52 @@ def place(joints, start_xy=(0.0, 0.0), heading: float = 0.0, fps: float = 30.0,
     out[..., :2] += start
     first = out[: max(1, int(round(fps))), [JOINT_INDEX["left_ankle"], JOINT_INDEX["right_ankle"]], 2]
     out[..., 2] += ankle_height - first.min()
+    return out
+
+
+#: The canonical skeleton as a tree from the pelvis: (parent, child) joint indices, parents first.
+_TREE = tuple((JOINT_INDEX[a], JOINT_INDEX[b]) for a, b in (
+    ("pelvis", "neck"), ("neck", "head"),
+    ("neck", "left_shoulder"), ("left_shoulder", "left_elbow"), ("left_elbow", "left_wrist"),
+    ("neck", "right_shoulder"), ("right_shoulder", "right_elbow"), ("right_elbow", "right_wrist"),
+    ("pelvis", "left_hip"), ("left_hip", "left_knee"), ("left_knee", "left_ankle"),
+    ("pelvis", "right_hip"), ("right_hip", "right_knee"), ("right_knee", "right_ankle"),
+))
+
+
+def retarget_lengths(joints, bone_lengths, ankle_height: float = ANKLE_HEIGHT, fps: float = 30.0) -> np.ndarray:
+    """Give a canonical sequence another body's bone lengths, keeping its bone directions.
+
+    joints : (T, 15, 3) canonical joints, metres, z up, floor at z = 0 (e.g. a placed clip)
+    bone_lengths : (14,) metres, in the order of :data:`occupose.joints.BONES`
+    ankle_height : the new body's ankle joints above the floor standing, metres
+    fps : the sequence's frame rate
+
+    Every bone keeps its direction in every frame and gets its new length, built out from
+    the pelvis. The pelvis path is scaled about its first frame's floor point by the ratio
+    of the new to the old leg length (thigh + shin, medians over frames), as stride
+    lengths scale with leg length; then z is shifted so the lowest ankle over the first
+    second is ``ankle_height`` above the floor. Returns (T, 15, 3).
+    """
+    joints = joints_array(joints, min_ndim=3)
+    if joints.ndim != 3 or joints.shape[0] < 1:
+        raise ValueError(f"joints must have shape (T, 15, 3) with T >= 1, got {joints.shape}")
+    lengths = np.asarray(bone_lengths, np.float64)
+    if lengths.shape != (len(BONES),) or not np.all(np.isfinite(lengths) & (lengths > 0)):
+        raise ValueError(f"bone_lengths must be {len(BONES)} positive lengths in metres, got {bone_lengths!r}")
+    by_pair = {frozenset(bone): length for bone, length in zip(BONES, lengths)}
+    old = {frozenset(bone): np.linalg.norm(joints[:, bone[1]] - joints[:, bone[0]], axis=-1) for bone in BONES}
+    legs = [frozenset((JOINT_INDEX[f"{s}_{a}"], JOINT_INDEX[f"{s}_{b}"]))
+            for s in ("left", "right") for a, b in (("hip", "knee"), ("knee", "ankle"))]
+    ratio = sum(by_pair[k] for k in legs) / sum(float(np.median(old[k])) for k in legs)
+    pelvis = joints[:, JOINT_INDEX["pelvis"]]
+    floor = np.array([pelvis[0, 0], pelvis[0, 1], 0.0])
+    out = np.empty_like(joints)
+    out[:, JOINT_INDEX["pelvis"]] = floor + ratio * (pelvis - floor)
+    for parent, child in _TREE:
+        bone = joints[:, child] - joints[:, parent]
+        norm = np.maximum(np.linalg.norm(bone, axis=-1, keepdims=True), 1e-9)
+        out[:, child] = out[:, parent] + bone / norm * by_pair[frozenset((parent, child))]
+    ankles = out[: max(1, int(round(fps))), [JOINT_INDEX["left_ankle"], JOINT_INDEX["right_ankle"]], 2]
+    out[..., 2] += ankle_height - ankles.min()
     return out

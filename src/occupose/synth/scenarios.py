@@ -55,6 +55,8 @@ class Scenario:
     static : furniture and room that never move; moving : per frame, furniture that moves
         (empty batches where nothing moves), or None
     events : named frame intervals [start, stop) worth knowing (e.g. "sitting")
+    conditions : what a randomized scene drew (occupose.synth.random_scenes; JSON-ready),
+        empty for the catalogue's scenes
     """
 
     name: str
@@ -67,6 +69,7 @@ class Scenario:
     motion_source: str
     moving: tuple[Primitives, ...] | None = None
     events: dict[str, tuple[int, int]] = field(default_factory=dict)
+    conditions: dict = field(default_factory=dict)
 
     @property
     def num_frames(self) -> int:
@@ -458,16 +461,22 @@ SCENARIOS: dict[str, ScenarioEntry] = {
 
 
 def build_scenario(name: str, seed: int = 0, sensor: str | None = None, use_mocap: bool = True) -> Scenario:
-    """Build the scenario ``name`` of :data:`SCENARIOS`.
+    """Build the scenario ``name`` of :data:`SCENARIOS`, or the random scene ``random-<N>``
+    (:func:`occupose.synth.random_scenes.random_scenario` of seed N).
 
-    seed : seeds the people's body sizes, girth and clothes
+    seed : seeds the people's body sizes, girth and clothes (a random scene is drawn from N)
     sensor : a camera preset name used for every camera instead of the scenario's own
     use_mocap : use real mocap clips when the shared data is present (False: always procedural)
     """
-    if name not in SCENARIOS:
-        raise ValueError(f"unknown scenario {name!r}; valid names: {', '.join(SCENARIOS)}")
+    from occupose.synth import random_scenes  # it builds on this module's Scenario
+
     if sensor is not None:
         sensor_spec(sensor)  # raises with the valid names
+    if random_scenes.is_random_name(name):
+        return random_scenes.random_scenario(random_scenes.seed_of(name), use_mocap=use_mocap, sensor=sensor)
+    if name not in SCENARIOS:
+        raise ValueError(f"unknown scenario {name!r}; valid names: {', '.join(SCENARIOS)}, "
+                         f"or {random_scenes.PREFIX}<seed>")
     entry = SCENARIOS[name]
     parts = entry.build(np.random.default_rng(seed), use_mocap, sensor)
     return Scenario(name=name, description=entry.summary, fps=FPS, **parts)

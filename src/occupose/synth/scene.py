@@ -105,10 +105,42 @@ def cabinet(center_xy, heading: float = 0.0, width: float = 1.0, depth: float = 
     return _part(center_xy, heading, (0, 0, height / 2), (depth / 2, width / 2, height / 2), color)
 
 
+def counter(center_xy, heading: float = 0.0, width: float = 1.8, depth: float = 0.6, height: float = 0.9,
+            overhang: float = 0.03, color=(220, 215, 205), top_color=(90, 85, 80)) -> Primitives:
+    """A kitchen counter: a closed base unit up to 4 cm below ``height`` and a 4 cm worktop
+    that overhangs it by ``overhang`` metres on every side; ``width`` along the local y axis."""
+    top = 0.04
+    return concat([
+        _part(center_xy, heading, (0, 0, (height - top) / 2), (depth / 2, width / 2, (height - top) / 2), color),
+        _part(center_xy, heading, (0, 0, height - top / 2), (depth / 2 + overhang, width / 2 + overhang, top / 2),
+              top_color),
+    ])
+
+
+def shelf(center_xy, heading: float = 0.0, width: float = 1.0, depth: float = 0.35, height: float = 1.8,
+          boards: int = 4, back: bool = False, color=WOOD) -> Primitives:
+    """An open bookshelf facing +x (local): two 2 cm side panels, a bottom and top board and
+    ``boards`` shelf boards between them (evenly spaced), optionally a back panel; the
+    openings between the boards let the camera see through when there is no back."""
+    if boards < 0:
+        raise ValueError(f"boards must be >= 0, got {boards!r}")
+    t = 0.01  # half thickness of a panel, metres
+    d, w = depth / 2, width / 2
+    parts = [_part(center_xy, heading, (0, side * (w - t), height / 2), (d, t, height / 2), color)
+             for side in (-1, 1)]
+    for k in range(boards + 2):
+        z = t + k * (height - 2 * t) / (boards + 1)
+        parts.append(_part(center_xy, heading, (0, 0, z), (d, w - 2 * t, t), color))
+    if back:
+        parts.append(_part(center_xy, heading, (-d + t / 2, 0, height / 2), (t / 2, w - 2 * t, height / 2), color))
+    return concat(parts)
+
+
 def pillar(center_xy, size: float = 0.4, height: float = 2.8, color=WALL) -> Primitives:
     """A square pillar from floor to ceiling."""
     return _part(center_xy, 0.0, (0, 0, height / 2), (size / 2, size / 2, height / 2), color)
 
 
 #: Furniture builders by name, for scenario definitions and the command line.
-FURNITURE = {"table": table, "couch": couch, "chair": chair, "cabinet": cabinet, "pillar": pillar}
+FURNITURE = {"table": table, "couch": couch, "chair": chair, "cabinet": cabinet, "counter": counter,
+             "shelf": shelf, "pillar": pillar}
