@@ -52,7 +52,7 @@ WITHIN_M = 0.10
 #: Shortest presence, seconds, for a person to count among a run's people and a track among its tracks.
 MIN_PRESENCE_S = 1.0
 #: Files of a recording folder that may hold its drawn conditions (a ``"conditions"`` object), in order.
-CONDITION_FILES = ("render.json", "recording.json")
+CONDITION_FILES = ("scene.json", "render.json", "recording.json")
 #: A camera whose optical axis points down more steeply than this, degrees below horizontal, is a top view.
 TOP_VIEW_PITCH_DEG = 60.0
 
