@@ -162,7 +162,7 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
 
 def recording_conditions(folder: str | Path, cameras: Sequence[Any], num_people: int) -> dict[str, Any]:
     """The conditions a recording was drawn under: the ``"conditions"`` object of the first of
-    ``CONDITION_FILES`` in ``folder`` that has one; else the two that can be read off any
+    ``CONDITION_FILES`` in ``folder`` that has a non-empty one (a catalogue scene's is empty); else the two that can be read off any
     recording: ``view`` ("top" when some camera's optical axis points down by more than
     ``TOP_VIEW_PITCH_DEG``, else "front") and ``people`` (``num_people``)."""
     folder = Path(folder)
@@ -170,7 +170,7 @@ def recording_conditions(folder: str | Path, cameras: Sequence[Any], num_people:
         path = folder / name
         if path.is_file():
             data = json.loads(path.read_text())
-            if isinstance(data, dict) and isinstance(data.get("conditions"), dict):
+            if isinstance(data, dict) and isinstance(data.get("conditions"), dict) and data["conditions"]:
                 return dict(data["conditions"])
     pitch = [math.degrees(math.asin(-float(np.asarray(c.world_from_camera)[2, 2]))) for c in cameras]
     return {"view": "top" if max(pitch) > TOP_VIEW_PITCH_DEG else "front", "people": int(num_people)}
