@@ -162,8 +162,8 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
 
 def recording_conditions(folder: str | Path, cameras: Sequence[Any], num_people: int) -> dict[str, Any]:
     """The conditions a recording was drawn under: the ``"conditions"`` object of the first of
-    ``CONDITION_FILES`` in ``folder`` that has a non-empty one (a catalogue scene's is empty); else the two that can be read off any
-    recording: ``view`` ("top" when some camera's optical axis points down by more than
+    ``CONDITION_FILES`` in ``folder`` that has a non-empty one (a catalogue scene's is
+    empty); else the two that can be read off any recording: ``view`` ("top" when some camera's optical axis points down by more than
     ``TOP_VIEW_PITCH_DEG``, else "front") and ``people`` (``num_people``)."""
     folder = Path(folder)
     for name in CONDITION_FILES:
