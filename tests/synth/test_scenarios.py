@@ -1,6 +1,7 @@
 """Scenes with ground truth: body shapes, furniture, chaining, the scenario catalogue, and
 that every scenario's occlusions do what it claims (rendered on a subset of frames)."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -288,3 +289,18 @@ def test_write_scenario_round_trip(tmp_path):
     assert (person == 1).sum() > 2000
     # the person's depth pixels lie about 3 m away, as placed
     assert 2.5 < np.median(depth[(person == 1) & (depth > 0)]) < 3.5
+
+
+def test_parts_the_sensor_does_not_measure_are_not_visible():
+    """Ground-truth visibility counts only measured pixels: with the sensor's working range
+    cut to end in front of the person, every present person has no visible joint, while
+    the same frames with the nominal range see most joints."""
+    scenario = build_scenario("no_occlusion", seed=1, use_mocap=False)
+    cam = scenario.cameras[0].name
+    model, options = scenario.noise[cam]
+    short = dataclasses.replace(scenario, noise={cam: (model, {**options, "max_range": 1.0})})
+    nominal = list(frames(scenario, seed=1, indices=range(60, 150, 30)))
+    cut = list(frames(short, seed=1, indices=range(60, 150, 30)))
+    assert all(f.present.all() for f in nominal + cut)
+    assert np.mean([f.visible.mean() for f in nominal]) > 0.7
+    assert not any(f.visible.any() for f in cut)

@@ -3,9 +3,11 @@
 Ground-truth visibility: in every frame each body part is also rendered alone (no
 furniture, no other people, no other part of the same body). A part is *visible* in a
 camera when at least half of the pixels it covers alone are still its own in the full
-scene (and at least ``MIN_PART_PIXELS``), so furniture, other people and the person's own
-body (an arm behind the torso) all hide it; a joint is visible when the part that starts
-at it (:data:`occupose.joints.JOINT_PART`) is visible to a camera whose image the joint projects into. A person is *present*
+scene and measured by the sensor (noisy depth > 0; and at least ``MIN_PART_PIXELS``), so
+furniture, other people, the person's own body (an arm behind the torso), the sensor's
+working range and its dropouts all hide it; a joint is visible when the part that starts
+at it (:data:`occupose.joints.JOINT_PART`) is visible to a camera whose image the joint
+projects into. A person is *present*
 in a frame when any camera covers any pixel of their parts alone, i.e. when they are inside
 some camera's view, hidden or not; ground-truth rows are written only for present people.
 """
@@ -50,9 +52,11 @@ class SynthFrame:
     present: np.ndarray
 
 
-def _part_counts(rendered: Rendered, person: int) -> np.ndarray:
-    """(len(PARTS),) pixel count of each body part of ``person`` in a rendered image."""
-    mask = rendered.person == person
+def _part_counts(rendered: Rendered, person: int, measured: np.ndarray) -> np.ndarray:
+    """(len(PARTS),) pixel count of each body part of ``person`` in a rendered image, counting
+    only the pixels the sensor measured (``measured``: (H, W) bool, the noisy depth > 0), so a
+    part beyond the working range or lost to dropouts is not seen."""
+    mask = (rendered.person == person) & measured
     return np.bincount(rendered.part[mask].ravel(), minlength=len(PARTS))
 
 
@@ -102,7 +106,7 @@ def frames(scenario: Scenario, seed: int = 0, num_frames: int | None = None,
             depth[cam.name] = apply_noise(full.depth, model, rng, fx=cam.fx, person=full.person, **options)
             for i, body in enumerate(bodies):
                 alone = _alone_counts(body, cam)
-                seen = _part_counts(full, i + 1)
+                seen = _part_counts(full, i + 1, depth[cam.name] > 0)
                 present[i] |= alone[1:].sum() > 0
                 part_visible = (alone > 0) & (seen >= np.maximum(0.5 * alone, MIN_PART_PIXELS))
                 visible[i] |= part_visible[list(JOINT_PART)] & _in_image(scenario.people[i].joints[t], cam)
