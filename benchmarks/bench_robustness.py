@@ -150,8 +150,9 @@ def benchmark(scenes: list[str], seeds: int, frames: int | None, out: Path, base
     for label in codes:  # today's code changes: its runs are made afresh; a baseline commit's are kept
         if label != baseline:
             shutil.rmtree(folders[label], ignore_errors=True)
+    # scene by scene, every code's runs together: the runs finished so far are comparable pairs
     tasks = [(source, settings, recordings[scene], folders[label] / scene / str(seed), seed)
-             for label, (source, settings) in codes.items() for scene in scenes for seed in range(seeds)]
+             for scene in scenes for seed in range(seeds) for label, (source, settings) in codes.items()]
     for task in tasks:
         task[3].parent.mkdir(parents=True, exist_ok=True)
     with ThreadPoolExecutor(jobs) as pool:
