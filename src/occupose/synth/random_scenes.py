@@ -705,7 +705,8 @@ def random_scenario(seed: int, use_mocap: bool = True, frames: int | None = None
 
     use_mocap : use the shared mocap clips when present (False: procedural motion only)
     frames : the scene's length (None: :data:`DEFAULT_FRAMES`)
-    sensor : a camera preset instead of the drawn one (the rest of the draw is unchanged)
+    sensor : a camera preset instead of the drawn one (the design's other choices stay;
+        the geometry, placed for this camera, and the noise come out differently)
 
     The draws come from ``np.random.SeedSequence(seed)``: the same arguments give the same
     scene, array for array. A design (the categorical draws) is kept for up to
