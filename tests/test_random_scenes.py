@@ -3,6 +3,7 @@ people in view and clear of furniture, and a short scene rendered and tracked en
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -196,3 +197,29 @@ def test_render_and_track_a_random_scene(tmp_path):
     assert result.exit_code == 0, result.output
     lines = (tmp_path / "run" / "tracks.csv").read_text().splitlines()
     assert len(lines) > 1
+
+
+def test_a_draw_records_the_draws_given_up_on():
+    # procedural, 40 frames: seed 3's first design cannot be placed in SCENE_TRIES geometries
+    draw = rs.draw_random_scenario(3, use_mocap=False, frames=FRAMES)
+    assert draw.scenario.conditions == rs.random_scenario(3, use_mocap=False, frames=FRAMES).conditions
+    assert draw.designs == 2
+    first = [r for r in draw.rejected if r["design"] == 0]
+    assert len(first) == rs.SCENE_TRIES and all(r["design"] < draw.designs for r in draw.rejected)
+    assert len(draw.rejected) - len(first) < rs.SCENE_TRIES  # the kept design's failed geometries
+    for r in draw.rejected:
+        low, high = rs.TOP_HEIGHT_RANGE if r["view"] == "top" else rs.FRONT_HEIGHT_RANGE
+        assert low <= r["camera_height_m"] <= high and r["motion"] in rs.PROCEDURAL_ACTIONS
+
+
+def test_a_walk_in_longer_than_a_short_scene_is_checked_on_its_last_frame():
+    # seed 8, 40 frames: the walk-in lasts longer than the scene, so the in-view test falls on
+    # its last frame (it once averaged an empty slice: numpy's "Mean of empty slice", and NaN passed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        scene = rs.random_scenario(8, use_mocap=False, frames=FRAMES)
+    info = scene.conditions["persons"][0]
+    assert info["start"] == "walk_in" and info["lead_in_frames"] > FRAMES
+    cam = scene.cameras[0]
+    options = scene.noise[cam.name][1]
+    assert placement.in_view(scene.people[0].joints[-1:], cam, options["min_range"], options["max_range"]).all()

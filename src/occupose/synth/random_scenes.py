@@ -598,8 +598,9 @@ def _draw_design(rng: np.random.Generator, use_mocap: bool, sensor: str | None) 
             "furniture": kinds[rng.integers(len(kinds))]}
 
 
-def _draw_scene(rng: np.random.Generator, seed: int, design: dict, frames: int) -> Scenario:
-    view = _draw_view(rng, design["preset"], design["view"])
+def _draw_scene(rng: np.random.Generator, seed: int, design: dict, view: _View, frames: int) -> Scenario:
+    """The scene of ``design`` seen by ``view``: people, furniture, room and noise drawn
+    (:class:`_Redraw` when a person cannot be placed)."""
     count, start = design["count"], design["starts"][0]
     furniture = {"kind": design["furniture"]}
     placed: list[_Placed] = []
@@ -647,17 +648,35 @@ def _draw_scene(rng: np.random.Generator, seed: int, design: dict, frames: int) 
                     events=events, conditions=conditions)
 
 
-def random_scenario(seed: int, use_mocap: bool = True, frames: int | None = None,
-                    sensor: str | None = None) -> Scenario:
-    """Draw the random scene of ``seed`` (module docstring).
+@dataclass(frozen=True)
+class RandomDraw:
+    """A random scene and the draws given up on before it (:func:`draw_random_scenario`).
 
-    use_mocap : use the shared mocap clips when present (False: procedural motion only)
-    frames : the scene's length (None: :data:`DEFAULT_FRAMES`)
-    sensor : a camera preset instead of the drawn one (the rest of the draw is unchanged)
-
-    The draws come from ``np.random.SeedSequence(seed)``: the same arguments give the same
-    scene, array for array.
+    scenario : the scene
+    rejected : one record per geometry draw that could not be placed, in order: ``design``
+        (how many designs were given up on before its own; 0: the first design), its
+        design's ``view``, ``camera``, ``people``, ``start`` (the first person's),
+        ``furniture`` and ``motion`` (the first person's motion family, "sit" for the
+        procedural sitting), and its camera's ``camera_height_m`` and ``tilt_deg``
+    designs : designs drawn, the kept one included (1: the first design was placed)
     """
+
+    scenario: Scenario
+    rejected: tuple[dict, ...]
+    designs: int
+
+
+def _rejected_record(design_index: int, design: dict, view: _View) -> dict:
+    """What :attr:`RandomDraw.rejected` keeps of a geometry draw that could not be placed."""
+    return {"design": design_index, "view": design["view"], "camera": design["preset"], "people": design["count"],
+            "start": design["starts"][0], "furniture": design["furniture"], "motion": design["families"][0],
+            "camera_height_m": round(view.height, 4), "tilt_deg": round(view.tilt, 3)}
+
+
+def draw_random_scenario(seed: int, use_mocap: bool = True, frames: int | None = None,
+                         sensor: str | None = None) -> RandomDraw:
+    """Draw the random scene of ``seed`` (:func:`random_scenario`, same arguments) and keep
+    a record of the draws that could not be placed on the way (:class:`RandomDraw`)."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
     frames = DEFAULT_FRAMES if frames is None else frames
@@ -666,14 +685,36 @@ def random_scenario(seed: int, use_mocap: bool = True, frames: int | None = None
     if sensor is not None:
         sensor_spec(sensor)
     rng = np.random.default_rng(np.random.SeedSequence(int(seed)))
-    for _ in range(DESIGN_TRIES):
+    rejected: list[dict] = []
+    for design_index in range(DESIGN_TRIES):
         design = _draw_design(rng, use_mocap, sensor)
         for _ in range(SCENE_TRIES):
+            view = _draw_view(rng, design["preset"], design["view"])
             try:
-                return _draw_scene(rng, int(seed), design, int(frames))
+                scenario = _draw_scene(rng, int(seed), design, view, int(frames))
             except _Redraw:
+                rejected.append(_rejected_record(design_index, design, view))
                 continue
+            return RandomDraw(scenario, tuple(rejected), design_index + 1)
     raise RuntimeError(f"random scene {seed}: no placement found in {DESIGN_TRIES} x {SCENE_TRIES} draws")
 
 
-__all__ = ["DEFAULT_FRAMES", "PREFIX", "is_random_name", "random_scenario", "seed_of", "suite"]
+def random_scenario(seed: int, use_mocap: bool = True, frames: int | None = None,
+                    sensor: str | None = None) -> Scenario:
+    """Draw the random scene of ``seed`` (module docstring).
+
+    use_mocap : use the shared mocap clips when present (False: procedural motion only)
+    frames : the scene's length (None: :data:`DEFAULT_FRAMES`)
+    sensor : a camera preset instead of the drawn one (the design's other choices stay;
+        the geometry, placed for this camera, and the noise come out differently)
+
+    The draws come from ``np.random.SeedSequence(seed)``: the same arguments give the same
+    scene, array for array. A design (the categorical draws) is kept for up to
+    :data:`SCENE_TRIES` geometry draws, then drawn again, up to :data:`DESIGN_TRIES` times
+    (:func:`draw_random_scenario` records the draws given up on).
+    """
+    return draw_random_scenario(seed, use_mocap, frames, sensor).scenario
+
+
+__all__ = ["DEFAULT_FRAMES", "PREFIX", "RandomDraw", "draw_random_scenario", "is_random_name", "random_scenario",
+           "seed_of", "suite"]
