@@ -178,7 +178,7 @@ def tables(results: dict[str, list[Run]]) -> str:
     sections = []
     for key in [None] + condition_keys(all_runs):
         rows = []
-        buckets = sorted({b for runs in results.values() for b in summarise(runs, key)})
+        buckets = list(dict.fromkeys(b for runs in results.values() for b in summarise(runs, key)))
         for bucket in buckets:
             for label, runs in results.items():
                 figures = summarise(runs, key).get(bucket)

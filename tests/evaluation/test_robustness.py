@@ -8,6 +8,7 @@ import pytest
 
 from occupose.camera import Camera, look_at
 from occupose.evaluation.robustness import (
+    condition_keys,
     recording_conditions,
     run_from_dict,
     score_run,
@@ -79,6 +80,20 @@ def test_summarise_buckets_runs_by_condition():
     assert overall["person_runs"] == 3 and overall["median_cm"] == pytest.approx(100 * 0.05 * math.sqrt(3))
     assert overall["fail_rate"] == pytest.approx(100 / 3) and overall["right_tracks"] == 100.0
     assert list(summarise(runs, "furniture")) == ["n/a"]
+
+
+def test_numeric_conditions_are_binned_and_lists_are_no_condition():
+    gt = _walker(0.0)[:, None]
+    visible = np.ones(gt.shape[:3], bool)
+    heights = [0.9, 2.5, 1.2, 1.9, 1.5, 2.2]
+    runs = [score_run(f"s{k}", 0, {"camera_height_m": h, "focal_scale": [1.0, 1.01], "people": 1}, gt, visible,
+                      {1: gt[:, 0] + 0.01 * k}, FPS) for k, h in enumerate(heights)]
+    buckets = summarise(runs, "camera_height_m")
+    assert list(buckets) == ["0.9..1.4", "1.4..2", "2..2.5"]  # terciles, in increasing order
+    assert [b["runs"] for b in buckets.values()] == [2, 2, 2]
+    assert buckets["0.9..1.4"]["mean_cm"] == pytest.approx(100 * 0.01 * (0 + 2) / 2 * math.sqrt(3))
+    assert list(summarise(runs, "people")) == ["1"]  # few values: one bucket each
+    assert condition_keys(runs) == ["camera_height_m", "people"]
 
 
 def test_recording_conditions_from_the_file_or_from_the_cameras(tmp_path):

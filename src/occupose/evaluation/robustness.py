@@ -55,6 +55,8 @@ MIN_PRESENCE_S = 1.0
 CONDITION_FILES = ("scene.json", "render.json", "recording.json")
 #: A camera whose optical axis points down more steeply than this, degrees below horizontal, is a top view.
 TOP_VIEW_PITCH_DEG = 60.0
+#: A numeric condition with more distinct values than this is bucketed in this many bins of about equal counts.
+NUMERIC_BINS = 3
 
 
 @dataclass(frozen=True)
@@ -212,24 +214,44 @@ def bucket_figures(runs: Sequence[Run]) -> dict[str, float | int]:
 
 def summarise(runs: Sequence[Run], by: str | None = None) -> dict[str, dict[str, float | int]]:
     """`bucket_figures` per value of the condition ``by`` (runs without it go to "n/a"),
-    buckets in sorted order; ``by=None``: one bucket "all"."""
+    buckets in sorted order; a numeric condition with more than ``NUMERIC_BINS`` values (a
+    camera's height, a noise level) in ``NUMERIC_BINS`` bins of about equal counts, named
+    "low..high" and in increasing order; ``by=None``: one bucket "all"."""
     if by is None:
         return {"all": bucket_figures(runs)}
+    values = [run.conditions.get(by) for run in runs]
+    numbers = [v for v in values if _is_number(v)]
     groups: dict[str, list[Run]] = {}
-    for run in runs:
-        groups.setdefault(str(run.conditions.get(by, "n/a")), []).append(run)
+    if len(set(numbers)) > NUMERIC_BINS:
+        edges = np.quantile(numbers, np.linspace(0.0, 1.0, NUMERIC_BINS + 1))
+        names = [f"{lo:.3g}..{hi:.3g}" for lo, hi in zip(edges[:-1], edges[1:])]
+        for name in names:
+            groups[name] = []
+        for run, value in zip(runs, values):
+            name = names[min(int(np.searchsorted(edges, value, side="right")) - 1, NUMERIC_BINS - 1)] \
+                if _is_number(value) else "n/a"
+            groups.setdefault(name, []).append(run)
+        return {name: bucket_figures(group) for name, group in groups.items() if group}
+    for run, value in zip(runs, values):
+        groups.setdefault("n/a" if value is None else str(value), []).append(run)
     return {value: bucket_figures(groups[value]) for value in sorted(groups)}
 
 
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def condition_keys(runs: Sequence[Run]) -> list[str]:
-    """The condition keys that some run has, in first-seen order."""
+    """The condition keys that some run has with a single value (a name, a number or a
+    flag: not a list such as ``focal_scale`` or a table such as ``persons``), in
+    first-seen order."""
     keys: dict[str, None] = {}
     for run in runs:
-        keys.update(dict.fromkeys(run.conditions))
+        keys.update(dict.fromkeys(k for k, v in run.conditions.items() if isinstance(v, (str, int, float, bool))))
     return list(keys)
 
 
 __all__ = [
-    "CONDITION_FILES", "MIN_PRESENCE_S", "PersonRun", "Run", "TOP_VIEW_PITCH_DEG", "WITHIN_M", "bucket_figures",
+    "CONDITION_FILES", "MIN_PRESENCE_S", "NUMERIC_BINS", "PersonRun", "Run", "TOP_VIEW_PITCH_DEG", "WITHIN_M", "bucket_figures",
     "condition_keys", "recording_conditions", "run_from_dict", "score_run", "summarise", "within_share",
 ]
