@@ -532,6 +532,26 @@ class OcclusionConfig(_Section):
 
 
 @dataclass(frozen=True)
+class RecoverConfig(_Section):
+    """The test of whether an estimate still explains its person's points, and the search
+    again from scratch, kept only when it explains them better (``occupose.pose.person``,
+    ``Person.recheck``)."""
+
+    _path = "recover"
+    enabled: bool = setting(True, "search again from scratch now and then, and soon after doubtful estimates")
+    every: int = setting(15, "search again after this many estimates", "frames", low=1)
+    explained_m: float = setting(0.05, "a point is explained when at most this far from the estimated body's "
+                                       "surface", "m", above=0)
+    min_explained: float = setting(0.7, "an estimate explaining a smaller share of its person's points is doubtful",
+                                   "share", low=0, high=1)
+    frames: int = setting(3, "after this many doubtful estimates in a row, search again at once", "frames", low=1)
+    cooldown: int = setting(5, "... but not within this many estimates of the last search", "frames", low=0)
+    points: int = setting(500, "the person's points tested (evenly taken from all of them)", "points", low=1)
+    samples: int = setting(10, "random perturbations of each candidate pose scored", "count", low=1)
+    steps: int = setting(3, "filter steps settling the best of them", "count", low=1)
+
+
+@dataclass(frozen=True)
 class TrackerConfig(_Section):
     """Every setting of a tracking run (see the module docstring); the default is ``ours``."""
 
@@ -548,6 +568,7 @@ class TrackerConfig(_Section):
     priors: PriorConfig = field(default_factory=PriorConfig)
     proposals: ProposalConfig = field(default_factory=ProposalConfig)
     occlusion: OcclusionConfig = field(default_factory=OcclusionConfig)
+    recover: RecoverConfig = field(default_factory=RecoverConfig)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], *, source: str = "config") -> TrackerConfig:

@@ -47,6 +47,17 @@ class PoseEstimator:
         self.filter.initialise(np.asarray(pose, float), spread)
         self._previous = np.asarray(pose, float).copy()
 
+    def state(self) -> tuple[np.ndarray, ...]:
+        """A copy of the filter's particles, weights and estimate and the velocity memory,
+        for :meth:`restore` (a search tried and not taken)."""
+        f = self.filter
+        return tuple(np.array(x, copy=True) for x in (f.particles, f.log_weights, f.estimate, self._previous))
+
+    def restore(self, state: tuple[np.ndarray, ...]) -> None:
+        """Go back to a :meth:`state`."""
+        f = self.filter
+        f.particles, f.log_weights, f.estimate, self._previous = (np.array(x, copy=True) for x in state)
+
     def shift(self, offset: np.ndarray) -> None:
         """Move every particle, the estimate and the velocity memory by ``offset`` (D,), e.g.
         the root's x, y to where a person reappeared (no velocity is inferred from the jump),

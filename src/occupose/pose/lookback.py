@@ -23,7 +23,7 @@ from occupose.config import TrackerConfig
 from occupose.grid.pixels import PersonPixels
 from occupose.grid.tracking import TrackState
 from occupose.pose.person import Person, PersonEstimate
-from occupose.pose.start import start_spread
+from occupose.pose.search import start_spread
 
 
 @dataclass

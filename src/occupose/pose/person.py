@@ -43,7 +43,8 @@ from occupose.pose.estimator import PoseEstimator
 from occupose.pose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
 from occupose.pose.problem import PoseProblem
 from occupose.pose.proposals import feet, unexplained_points
-from occupose.pose.views import at_border, views_from_pixels
+from occupose.pose.search import best_sample, explained_share, start_candidates, start_spread
+from occupose.pose.views import at_border, modelled, views_from_pixels
 
 
 @dataclass
@@ -116,6 +117,9 @@ class Person:
         self.shaped = not (config.shape.learn and model.name == "full")  # resized, or never to be
         self.tops: list[float] = []  # statures measured on its first estimates (learn_stature)
         self.problem.stature_known = False  # until learn_stature has measured it again
+        self.doubtful = 0  # doubtful estimates in a row (recheck)
+        self.since_search = 0  # estimates since the last search again (recheck)
+        self.searches = self.recoveries = 0  # searches again, and those taken (recheck)
 
     def update(self, pixels: PersonPixels, depths: Mapping[str, np.ndarray], assigned: Mapping[str, np.ndarray],
                state: TrackState) -> PersonEstimate:
@@ -156,6 +160,7 @@ class Person:
         seen = observation_from_views(views_from_pixels(pixels, depths, self.cameras, self.model, config.pose,
                                                         self.body_distance(moved)), config.pose.max_points)
         if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
+            self.recheck(pixels, depths)
             return self.estimate(False)
         self.problem.walking, self.problem.standing = self.walking(), self.standing()
         pose = self.estimator.step(seen, active=active, diffusion_scale=scale)
@@ -166,6 +171,7 @@ class Person:
         self.face_the_better_way()
         self.learn_stature(seen)
         self.learn_shape(seen)
+        self.recheck(pixels, depths)
         return self.estimate(True)
 
     def _place_hidden_legs(self, pose: np.ndarray, seen: Observation) -> np.ndarray:
@@ -265,6 +271,61 @@ class Person:
             self.pose = twin
             self.twin_better = []
             self.since_turn = 0
+
+    def recheck(self, pixels: PersonPixels, depths: Mapping[str, np.ndarray]) -> None:
+        """With ``recover.enabled``: search again from scratch every ``recover.every``
+        estimates, and at once (but not within ``recover.cooldown`` estimates of the last
+        search) after ``recover.frames`` doubtful estimates in a row: estimates that explain
+        less than ``recover.min_explained`` of the person's points (``recover.points`` of its
+        pixels' points, explained within ``recover.explained_m`` of the body). The search is a
+        start's (:func:`occupose.pose.search.start_candidates` at ``start.headings`` headings
+        round the circle, and the estimate itself; ``recover.samples`` perturbations of each),
+        settled by ``recover.steps`` filter steps on all the person's points; it is taken,
+        the person keeping its id, when it is both more likely and explains more of the
+        points than the estimate, else the filter goes back to where it was. The filter
+        follows its points only near its last estimate (:meth:`body_distance`), and the
+        walking prior and the occlusion memory hold it where it went, so an estimate gone
+        wrong does not always come back by itself; neither test alone is safe: the
+        likelihood prefers a body turned round about as often as not, and a body off its
+        points may still cover most of them."""
+        recover, start = self.config.recover, self.config.start
+        self.since_search += 1
+        points = pixels.points
+        points = points[modelled(points, self.model, self.config.pose)]
+        if not recover.enabled or len(points) == 0:
+            return
+        points = points[np.linspace(0, len(points) - 1, min(recover.points, len(points))).astype(int)]
+        share = explained_share(self.body_distance(), points, recover.explained_m)
+        self.doubtful = self.doubtful + 1 if share < recover.min_explained else 0
+        if self.since_search < recover.every and (self.doubtful < recover.frames
+                                                  or self.since_search <= recover.cooldown):
+            return
+        self.doubtful = self.since_search = 0
+        self.searches += 1
+        seen = observation_from_views(views_from_pixels(pixels, depths, self.cameras, self.model, self.config.pose),
+                                      self.config.pose.max_points)
+        before = self.estimator.state()
+        self.problem.set_observation(seen)
+        centre = np.mean(points, axis=0)
+        headings = np.linspace(-np.pi, np.pi, start.headings, endpoint=False)
+        moved = self.pose.copy()
+        moved[:2] = centre[:2] + self.anchor
+        candidates = np.vstack([start_candidates(self.model, centre, headings, start.seat_share),
+                                self.pose[None], moved[None]])
+        spread = start_spread(self.model, start)
+        self.estimator.initialise(best_sample(self.problem, candidates, spread, recover.samples,
+                                              self.estimator.filter.rng), spread)
+        for _ in range(recover.steps):
+            pose = self.estimator.step(seen)
+        old, new = self.problem.log_likelihood(np.stack([self.pose, pose])).sum(axis=1)
+        if new <= old or explained_share(self.body_distance(pose), points, recover.explained_m) <= share:
+            self.estimator.restore(before)
+            return
+        self.recoveries += 1
+        self.pose = pose
+        self.path[-1] = pose[:2].copy()
+        if self.occlusion is not None:
+            self.occlusion.memory = pose.copy()
 
     def learn_shape(self, observation: Observation) -> None:
         """With ``shape.learn``: measure the neck depth and shoulder breadth

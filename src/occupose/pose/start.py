@@ -6,9 +6,9 @@ people beside it) have been person-like for ``start.frames`` frames in a row: ta
 (:func:`occupose.pose.views.at_border`) and seen by some camera as a solid silhouette
 (:func:`silhouette_fill`; a wall's scattered readings in a person's shadow from a second
 camera are not). Its body size is measured on those frames' points pooled, and the start
-pose is the best of :func:`start_candidates` (standing and seated, at the headings of
-:func:`start_headings`) and of random perturbations of them, settled by a few filter
-steps. The settings are the fields of :class:`occupose.config.StartConfig`.
+pose is the best of :func:`occupose.pose.search.start_candidates` (standing and seated, at
+the headings of :func:`start_headings`) and of random perturbations of them, settled by a
+few filter steps. The settings are the fields of :class:`occupose.config.StartConfig`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from occupose.body import BodyModel, body_model, dims_from_observation, seated_pose, standing_pose
+from occupose.body import body_model, dims_from_observation
 from occupose.body.size import breadth_profile, neck_and_shoulders, top_height
 from occupose.camera import Camera, points_from_depth
 from occupose.config import SizeConfig, StartConfig, TrackerConfig
@@ -27,6 +27,7 @@ from occupose.grid.pixels import PersonPixels
 from occupose.grid.spec import GridSpec
 from occupose.likelihood import observation_from_views
 from occupose.pose.person import Person
+from occupose.pose.search import best_sample, start_candidates, start_spread
 from occupose.pose.views import at_border, views_from_pixels
 
 
@@ -116,30 +117,6 @@ def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera, c
     return headings[np.abs(off) < np.pi / 2 + 1e-9]
 
 
-def start_candidates(model: BodyModel, centroid: np.ndarray, headings: np.ndarray,
-                     seat_share: float = StartConfig.seat_share) -> np.ndarray:
-    """(S, D) start poses for a person whose blob is centred at ``centroid`` (3,) metres:
-    standing and (for models with legs) seated on a seat ``seat_share`` of the stature
-    high (:mod:`occupose.body.postures`), at every heading of ``headings`` (radians), the
-    pelvis above the centroid."""
-    postures = [standing_pose(model)]
-    if "left_knee" in model.dof_names:
-        postures.append(seated_pose(model, seat_share * model.dims.height))
-    poses = np.repeat(np.array(postures), len(headings), axis=0)
-    poses[:, model.dof("heading")] = np.tile(headings, len(postures))
-    poses[:, 0:2] = centroid[:2]  # pelvis above the blob's centre; the filter settles the rest
-    return poses
-
-
-def start_spread(model: BodyModel, config: StartConfig) -> np.ndarray:
-    """(D,) spread (std) of a new person's particles around its start: ``spread_position``
-    metres on the root's x, y, z, ``spread_heading`` on the heading, ``spread_angle`` on
-    every other angle, radians."""
-    spread = np.where(model.angular, config.spread_angle, config.spread_position)
-    spread[model.dof_names.index("heading")] = config.spread_heading
-    return spread
-
-
 def start_person(points: np.ndarray, pixels: PersonPixels, depths: Mapping[str, np.ndarray], centroid: np.ndarray,
                  velocity: np.ndarray, cameras: Sequence[Camera], model_name: str, config: TrackerConfig, fps: float,
                  rng: np.random.Generator) -> Person:
@@ -160,10 +137,7 @@ def start_person(points: np.ndarray, pixels: PersonPixels, depths: Mapping[str, 
     headings = start_headings(velocity, centre, cameras[0], config.start.headings, config.carry.walking_speed)
     candidates = start_candidates(person.model, centre, headings, config.start.seat_share)
     spread = start_spread(person.model, config.start)
-    samples = np.repeat(candidates, config.start.samples, axis=0)
-    samples += rng.standard_normal(samples.shape) * spread
-    samples = np.clip(samples, problem.limits[:, 0], problem.limits[:, 1])
-    best = samples[int(np.argmax(problem.log_likelihood(samples).sum(axis=1)))]
+    best = best_sample(problem, candidates, spread, config.start.samples, rng)
     person.estimator.initialise(best, spread)
     for _ in range(config.start.steps):
         best = person.estimator.step(seen)

@@ -35,12 +35,20 @@ def views_from_pixels(pixels: PersonPixels, depths: Mapping[str, np.ndarray], ca
         if near is not None and len(own):
             gated = near(points) < pose.gate_m
             keep = gated if gated.mean() >= pose.gate_keep else keep
-        if model.name == "upper":
-            keep &= points[:, 2] >= pose.upper_cut * model.dims.height
+        keep &= modelled(points, model, pose)
         mask = np.zeros(camera.height * camera.width, bool)
         mask[own[keep]] = True
         views.append(View(camera, depths[camera.name], mask.reshape(camera.height, camera.width)))
     return views
+
+
+def modelled(points: np.ndarray, model: BodyModel, pose: PoseConfig) -> np.ndarray:
+    """(N,) bool: which of a person's points (N, 3) world metres ``model`` is meant to
+    explain: all for the full body; for the upper body those above ``pose.upper_cut`` of
+    its stature."""
+    if model.name == "upper":
+        return points[:, 2] >= pose.upper_cut * model.dims.height
+    return np.ones(len(points), bool)
 
 
 def at_border(pixels: PersonPixels, cameras: Sequence[Camera], border_px: int) -> bool:
