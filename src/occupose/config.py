@@ -252,6 +252,8 @@ class StartConfig(_Section):
                                                                "pixels' columns and rows", "percent", low=0, high=100)
     border_px: int = setting(3, "pixels this close to the left, right or top image edge: not fully in view",
                              "pixels", low=0)
+    border_count: int = setting(20, "... when at least this many of them are (a body cut by the edge has hundreds "
+                                    "there; a few are stray readings)", "pixels", low=1)
     clearance: float = setting(0.5, "no start within this of a tracked person's pelvis (a piece of its blob)",
                                "m", low=0)
     headings: int = setting(12, "headings tried around the circle (the half facing the way walked, or the "

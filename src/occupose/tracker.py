@@ -155,7 +155,7 @@ class Tracker:
             self.grid.update(depths, hold=self._hold())
         if self.frame < self.config.start.still_frames:  # people still from the first frame are no background
             self.grid.seed_moving(still_people(self.grid.states, self.spec, depths, self.cameras, self.config.start,
-                                               self.config.size) & ~self.grid.moving_mask())
+                                               self.config.size, self.config.blobs.join_m) & ~self.grid.moving_mask())
         clock = _tick(seconds, "grid", clock)
         blobs = self.config.blobs
         labels, found = blobs_from_mask(self.grid.moving_mask(), self.spec, min_cells=blobs.min_cells,

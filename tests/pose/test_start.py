@@ -28,6 +28,10 @@ def test_a_person_cut_by_the_image_edge_does_not_start(small_camera):
     assert at_border(observation((20, 110), (0, 30)), [camera], BORDER)  # left edge
     assert at_border(observation((20, 110), (140, 160)), [camera], BORDER)  # right edge
     assert at_border(observation((0, 60), (60, 90)), [camera], BORDER)  # top edge
+    stray = observation((20, 110), (60, 90))
+    stray.pixels["cam"] = np.union1d(stray.pixels["cam"], [5 * camera.width])  # one reading at the left edge
+    stray.camera_points["cam"] = np.zeros((stray.pixels["cam"].size, 3))
+    assert at_border(stray, [camera], BORDER) and not at_border(stray, [camera], BORDER, StartConfig.border_count)
 
 
 def test_with_two_cameras_one_that_sees_the_whole_person_is_enough_to_start(small_camera):

@@ -150,7 +150,7 @@ class Person:
             if self.occlusion.suspended:  # kept, not estimated: walks on, or stays with its blob
                 # (at the image's edge it stays with its blob: the camera cannot show it walk on)
                 if (np.hypot(*self.step()) * self.fps > config.carry.walk_from
-                        and not at_border(pixels, self.cameras, config.start.border_px)):
+                        and not at_border(pixels, self.cameras, config.start.border_px, config.start.border_count)):
                     self.carry()
                 else:
                     self.pose, self.lost = moved, True

@@ -32,7 +32,7 @@ from occupose.pose.views import at_border, views_from_pixels
 
 
 def still_people(states: np.ndarray, spec: GridSpec, depths: Mapping[str, np.ndarray], cameras: Sequence[Camera],
-                 config: StartConfig, size: SizeConfig) -> np.ndarray:
+                 config: StartConfig, size: SizeConfig, join_m: float | None = None) -> np.ndarray:
     """(nx, ny, nz) bool: the occupied cells of the static structures shaped like a person.
 
     The grid learns the background from the first frame, so a person in view and still
@@ -42,18 +42,33 @@ def still_people(states: np.ndarray, spec: GridSpec, depths: Mapping[str, np.nda
     the grid's top, that spans at most ``config.still_width`` across the floor, and whose
     points (those of the camera that sees most of them) show a head above wider
     shoulders (:func:`occupose.body.size.neck_and_shoulders`: a table, a chair, a cabinet
-    or a wall do not) is taken for a person.
+    or a wall do not) is taken for a person. The groups are the connected ones, and also
+    those joined as blobs are (``join_m``, metres, :func:`occupose.grid.blobs.blobs_from_mask`;
+    None: only the connected ones): from a ceiling camera the occupied cells of a still
+    person are the top of the head and the shoulders, apart, while a person standing
+    behind a counter joins it.
 
     states : (nx, ny, nz) uint8 grid states; depths : camera name -> (H, W) float32 metres
     """
     occupied = states == O
     occupied[:, :, :int(round((config.still_floor - spec.origin[2]) / spec.cell))] = False
-    labels, blobs = blobs_from_mask(occupied, spec, min_cells=1, min_height=0.0, min_top=config.min_top, join_m=None)
     found = np.zeros(spec.shape, bool)
-    candidates = [b for b in blobs if np.all(b.high[:2] - b.low[:2] <= config.still_width + 1e-9)
-                  and b.high[2] < spec.high[2] - 1e-9]  # not reaching the grid's top (a wall, a pillar)
+    for join in dict.fromkeys((None, join_m)):
+        labels, blobs = blobs_from_mask(occupied, spec, min_cells=1, min_height=0.0, min_top=config.min_top,
+                                        join_m=join)
+        candidates = [b for b in blobs if np.all(b.high[:2] - b.low[:2] <= config.still_width + 1e-9)
+                      and b.high[2] < spec.high[2] - 1e-9]  # not reaching the grid's top (a wall, a pillar)
+        for b in _shaped_like_a_person(candidates, labels, spec, depths, cameras, size):
+            found.reshape(-1)[b.cells] = True
+    return found
+
+
+def _shaped_like_a_person(candidates: list, labels: np.ndarray, spec: GridSpec, depths: Mapping[str, np.ndarray],
+                          cameras: Sequence[Camera], size: SizeConfig) -> list:
+    """The blobs of ``candidates`` (of the label volume ``labels``) whose points, those of
+    the camera that sees most of them, show a head above wider shoulders."""
     if not candidates:
-        return found
+        return []
     flat = labels.reshape(-1)
     points_of = {b.label: [] for b in candidates}
     for camera in cameras:
@@ -62,11 +77,8 @@ def still_people(states: np.ndarray, spec: GridSpec, depths: Mapping[str, np.nda
         label = np.where(cell[pixels] >= 0, flat[np.maximum(cell[pixels], 0)], 0)
         for b in candidates:
             points_of[b.label].append(points[label == b.label])
-    for b in candidates:
-        points = max(points_of[b.label], key=len)
-        if len(points) >= size.top_rank and neck_and_shoulders(breadth_profile(points, size), size) is not None:
-            found.reshape(-1)[b.cells] = True
-    return found
+    return [b for b in candidates if len(points := max(points_of[b.label], key=len)) >= size.top_rank
+            and neck_and_shoulders(breadth_profile(points, size), size) is not None]
 
 
 def person_like(pixels: PersonPixels, cameras: Sequence[Camera], config: StartConfig, top_rank: int) -> bool:
@@ -74,7 +86,7 @@ def person_like(pixels: PersonPixels, cameras: Sequence[Camera], config: StartCo
     ``top_rank`` : the rank of the point taken as the top (:class:`occupose.config.SizeConfig`)."""
     points = pixels.points
     return (len(points) >= config.min_points and top_height(points[:, 2], top_rank) >= config.min_top
-            and not at_border(pixels, cameras, config.border_px)
+            and not at_border(pixels, cameras, config.border_px, config.border_count)
             and max(silhouette_fill(pixels.pixels[c.name], c.width, config.fill_quantiles) for c in cameras)
             >= config.min_fill)
 

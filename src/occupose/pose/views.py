@@ -51,17 +51,20 @@ def modelled(points: np.ndarray, model: BodyModel, pose: PoseConfig) -> np.ndarr
     return np.ones(len(points), bool)
 
 
-def at_border(pixels: PersonPixels, cameras: Sequence[Camera], border_px: int) -> bool:
-    """Whether the person's pixels come within ``border_px`` of the left, right or top edge
-    of every camera's image that sees them: not fully in view of any camera, so its points
-    would misjudge its size. (The bottom edge is allowed: a camera may cut the feet of a
-    person who is near it. With several cameras, one that sees the whole person is enough:
-    the pooled points hold the whole body.)"""
+def at_border(pixels: PersonPixels, cameras: Sequence[Camera], border_px: int, border_count: int = 1) -> bool:
+    """Whether at least ``border_count`` of the person's pixels come within ``border_px`` of
+    the left, right or top edge of every camera's image that sees them: not fully in view of
+    any camera, so its points would misjudge its size. (The bottom edge is allowed: a camera
+    may cut the feet of a person who is near it. With several cameras, one that sees the
+    whole person is enough: the pooled points hold the whole body. A body cut by the edge
+    has a strip of hundreds of pixels there; a few stray ones, a noisy floor reading given
+    to the person, are no cut.)"""
     cut = []
     for camera in cameras:
         own = pixels.pixels[camera.name]
         if len(own) == 0:
             continue
         v, u = np.divmod(own, camera.width)
-        cut.append(bool(u.min() < border_px or u.max() >= camera.width - border_px or v.min() < border_px))
+        near = (u < border_px) | (u >= camera.width - border_px) | (v < border_px)
+        cut.append(int(np.count_nonzero(near)) >= border_count)
     return all(cut)
