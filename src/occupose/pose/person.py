@@ -149,8 +149,9 @@ class Person:
             self.part_visible = self.occlusion.update(moved, hidden)
             if self.occlusion.suspended:  # kept, not estimated: walks on, or stays with its blob
                 # (at the image's edge it stays with its blob: the camera cannot show it walk on)
+                start = config.start
                 if (np.hypot(*self.step()) * self.fps > config.carry.walk_from
-                        and not at_border(pixels, self.cameras, config.start.border_px, config.start.border_count)):
+                        and not at_border(pixels, self.cameras, start.border_px, start.border_count)):
                     self.carry()
                 else:
                     self.pose, self.lost = moved, True
@@ -160,7 +161,6 @@ class Person:
         seen = observation_from_views(views_from_pixels(pixels, depths, self.cameras, self.model, config.pose,
                                                         self.body_distance(moved)), config.pose.max_points)
         if len(seen.points) == 0:  # e.g. the upper body's points all below its cut (crouching)
-            self.recheck(pixels, depths)
             return self.estimate(False)
         self.problem.walking, self.problem.standing = self.walking(), self.standing()
         pose = self.estimator.step(seen, active=active, diffusion_scale=scale)
@@ -279,7 +279,8 @@ class Person:
         less than ``recover.min_explained`` of the person's points (``recover.points`` of its
         pixels' points, explained within ``recover.explained_m`` of the body). The search is a
         start's (:func:`occupose.pose.search.start_candidates` at ``start.headings`` headings
-        round the circle, and the estimate itself; ``recover.samples`` perturbations of each),
+        round the circle, the estimate itself, and the estimate moved onto the points'
+        centre; ``recover.samples`` perturbations of each),
         settled by ``recover.steps`` filter steps on all the person's points; it is taken,
         the person keeping its id, when it is both more likely and explains more of the
         points than the estimate, else the filter goes back to where it was. The filter
@@ -290,9 +291,11 @@ class Person:
         points may still cover most of them."""
         recover, start = self.config.recover, self.config.start
         self.since_search += 1
+        if not recover.enabled:
+            return
         points = pixels.points
         points = points[modelled(points, self.model, self.config.pose)]
-        if not recover.enabled or len(points) == 0:
+        if len(points) == 0:
             return
         points = points[np.linspace(0, len(points) - 1, min(recover.points, len(points))).astype(int)]
         share = explained_share(self.body_distance(), points, recover.explained_m)

@@ -4,7 +4,8 @@
 
 The candidates are standing and seated poses at a set of headings above the centre of the
 person's points; the search scores random perturbations of each and takes the best. The
-settings are the fields of :class:`occupose.config.StartConfig`.
+settings are the fields of :class:`occupose.config.StartConfig` (and, searching again,
+:class:`occupose.config.RecoverConfig`).
 """
 
 from __future__ import annotations
