@@ -540,7 +540,8 @@ class RecoverConfig(_Section):
     ``Person.recheck``)."""
 
     _path = "recover"
-    enabled: bool = setting(True, "search again from scratch now and then, and soon after doubtful estimates")
+    enabled: bool = setting(False, "search again from scratch now and then, and soon after doubtful estimates "
+                                   "(off: on the random scenes it made more runs worse than better)")
     every: int = setting(15, "search again after this many estimates", "frames", low=1)
     explained_m: float = setting(0.05, "a point is explained when at most this far from the estimated body's "
                                        "surface", "m", above=0)

@@ -37,7 +37,7 @@ def test_the_test_fires_on_a_lost_estimate_and_not_on_a_good_one(walk):
     undisturbed walk; thrown 0.6 m off (none of its points near it), the estimate is
     doubtful at once and searched for again after ``recover.frames`` frames."""
     scenario, rendered = walk
-    config = TrackerConfig().with_values({"recover.every": 1000})
+    config = TrackerConfig().with_values({"recover.enabled": True, "recover.every": 1000})
     tracker = Tracker(scenario.cameras, scenario.fps, config, seed=0)
     for f in rendered[:LOST_AT + 1]:
         tracker.update(f.depth)
@@ -54,12 +54,12 @@ def test_the_test_fires_on_a_lost_estimate_and_not_on_a_good_one(walk):
 
 @pytest.mark.parametrize("throw", [0.6, -0.4])
 def test_an_estimate_thrown_off_its_person_comes_back_sooner(walk, throw):
-    """With the default settings (a search every 15 frames, and at once after doubtful
-    ones) the estimate thrown 0.6 m or 0.4 m off is back within 9 cm 4 frames later and
+    """With the searches on (every 15 frames, and at once after doubtful ones; off by
+    default) the estimate thrown 0.6 m or 0.4 m off is back within 9 cm 4 frames later and
     stays there (measured at most 8 cm), the same id, no other track; without the searches
     it comes back by itself more slowly (measured: a mean of 13 and 14 cm over the 10
     frames from then on)."""
-    tracker, errors = _run(walk, {}, throw)
+    tracker, errors = _run(walk, {"recover.enabled": True}, throw)
     assert tracker.people[1].recoveries >= 1 and list(tracker.people) == [1]
     assert max(errors[4:]) < 0.09, np.round(errors, 3)
     _, without = _run(walk, {"recover.enabled": False}, throw)
