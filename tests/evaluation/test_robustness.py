@@ -63,6 +63,10 @@ def test_score_run_counts_switches_lasting_tracks_and_a_missed_person():
     assert missed.fail and missed.coverage == 0.0 and missed.within10 == 0.0 and math.isnan(missed.mean_cm)
     text = json.dumps(alone.as_dict())
     assert json.dumps(run_from_dict(json.loads(text)).as_dict()) == text  # NaN != NaN: compared as JSON
+    unseen = visible.copy()
+    unseen[:, 1] = False  # the second person is never in the sensor's sight: no person of the run
+    hidden = score_run("scene", 0, {}, gt, unseen, {1: gt[:, 0] + 0.03}, FPS)
+    assert hidden.people == 1 and hidden.right_tracks and [p.person for p in hidden.persons] == [0]
 
 
 def test_summarise_buckets_runs_by_condition():

@@ -1,7 +1,8 @@
 """Robustness figures: per person-run metrics and their aggregates per condition bucket.
 
 A *run* is one recording tracked once (one tracker seed); a *person-run* is one ground-truth
-person of a run. Each person-run gets, from occupose.evaluation.matching.score (the tracks
+person of a run in the sensor's sight for at least ``MIN_PRESENCE_S`` (a person the sensor
+never sees is no person of the run). Each person-run gets, from occupose.evaluation.matching.score (the tracks
 matched to people for the whole sequence):
 
 mean_cm
@@ -138,8 +139,11 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
     gt_joints = np.asarray(gt_joints, dtype=np.float64)
     gt_visible = np.asarray(gt_visible, dtype=bool)
     lasting = max(1, min(int(round(MIN_PRESENCE_S * fps)), gt_joints.shape[0]))  # a short recording: all of it
+    present = np.any(gt_visible, axis=2).sum(axis=0)  # (P,) frames in sight
     persons = []
     for index, person in enumerate(result.persons):
+        if present[index] < lasting:  # no person of the run (never in the sensor's sight, or too briefly)
+            continue
         if person.track is None:
             est = np.full(gt_joints.shape[:1] + gt_joints.shape[2:], np.nan)
             evaluated = np.ones(gt_joints.shape[2], dtype=bool)
@@ -154,7 +158,6 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
             within10=within_share(gt_joints[:, index][:, evaluated], visible, est[:, evaluated]),
             coverage=row.coverage, fail=row.fail, switches=person.identity_switches,
         ))
-    present = np.any(gt_visible, axis=2).sum(axis=0)  # (P,) frames in sight
     people = int(np.count_nonzero(present >= lasting))
     reported = [int(np.count_nonzero(np.any(np.all(np.isfinite(np.asarray(t)), axis=2), axis=1)))
                 for t in tracks.values()]
