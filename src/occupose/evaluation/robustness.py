@@ -2,8 +2,8 @@
 
 A *run* is one recording tracked once (one tracker seed); a *person-run* is one ground-truth
 person of a run in the sensor's sight for at least ``MIN_PRESENCE_S`` (a person the sensor
-never sees is no person of the run). Each person-run gets, from occupose.evaluation.matching.score (the tracks
-matched to people for the whole sequence):
+never sees is no person of the run). Each person-run gets, from
+occupose.evaluation.matching.score (the tracks matched to people for the whole sequence):
 
 mean_cm
     Table I's mean of ``D_t`` over all evaluated joints (errors module), cm; NaN when no
@@ -168,8 +168,9 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
 def recording_conditions(folder: str | Path, cameras: Sequence[Any], num_people: int) -> dict[str, Any]:
     """The conditions a recording was drawn under: the ``"conditions"`` object of the first of
     ``CONDITION_FILES`` in ``folder`` that has a non-empty one (a catalogue scene's is
-    empty); else the two that can be read off any recording: ``view`` ("top" when some camera's optical axis points down by more than
-    ``TOP_VIEW_PITCH_DEG``, else "front") and ``people`` (``num_people``)."""
+    empty); else the two that can be read off any recording: ``view`` ("top" when some
+    camera's optical axis points down by more than ``TOP_VIEW_PITCH_DEG``, else "front")
+    and ``people`` (``num_people``)."""
     folder = Path(folder)
     for name in CONDITION_FILES:
         path = folder / name
@@ -250,11 +251,12 @@ def condition_keys(runs: Sequence[Run]) -> list[str]:
     first-seen order."""
     keys: dict[str, None] = {}
     for run in runs:
-        keys.update(dict.fromkeys(k for k, v in run.conditions.items() if isinstance(v, (str, int, float, bool))))
+        keys.update(dict.fromkeys(k for k, v in run.conditions.items()
+                                  if isinstance(v, (str, int, float, bool))))
     return list(keys)
 
 
 __all__ = [
-    "CONDITION_FILES", "MIN_PRESENCE_S", "NUMERIC_BINS", "PersonRun", "Run", "TOP_VIEW_PITCH_DEG", "WITHIN_M", "bucket_figures",
-    "condition_keys", "recording_conditions", "run_from_dict", "score_run", "summarise", "within_share",
+    "CONDITION_FILES", "MIN_PRESENCE_S", "NUMERIC_BINS", "PersonRun", "Run", "TOP_VIEW_PITCH_DEG", "WITHIN_M",
+    "bucket_figures", "condition_keys", "recording_conditions", "run_from_dict", "score_run", "summarise", "within_share",
 ]
