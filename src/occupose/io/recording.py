@@ -350,7 +350,9 @@ def _read_png(file: Path, kind: str, camera: Camera, *, decode: bool = True) -> 
                     f"{file}: expected {what} PNG (mode {mode!r}), got a {image.format} image of mode {image.mode!r}"
                 )
             if image.size != (width, height):
-                raise RecordingError(f"{file}: image is {image.size[0]}x{image.size[1]}, the camera is {width}x{height}")
+                raise RecordingError(
+                    f"{file}: image is {image.size[0]}x{image.size[1]}, the camera is {width}x{height}"
+                )
             return np.asarray(image) if decode else None
     except RecordingError:
         raise
@@ -377,7 +379,9 @@ class Recording:
         except FileNotFoundError:
             raise FileNotFoundError(f"{self.path}: no such recording folder") from None
         except OSError as problem:
-            raise RecordingError(f"{self.path}: cannot read the recording folder ({problem.strerror or problem})") from None
+            raise RecordingError(
+                f"{self.path}: cannot read the recording folder ({problem.strerror or problem})"
+            ) from None
         self.fps, self.num_frames, self.cameras = _read_header(self.path / _JSON_NAME)
         self._by_name = {c.name: c for c in self.cameras}
         self._color_names = []
