@@ -14,12 +14,23 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from occupose._validate import bool_array, positive_float
-from occupose.evaluation.errors import TableRow, _nanmean, frame_errors, joint_errors, per_joint_errors, table_row
-from occupose.joints import JOINTS, NUM_JOINTS
+from occupose.evaluation.errors import (
+    MISSED_ERROR_M,
+    TableRow,
+    _nanmean,
+    frame_errors,
+    joint_errors,
+    per_joint_errors,
+    table_row,
+)
+from occupose.joints import JOINTS, NUM_JOINTS, UPPER_JOINTS
 
 #: Cost of a frame where a person has ground truth and a track has no estimate, when
 #: matching tracks to people (metres, as a mean joint distance).
 ABSENT_COST_M = 0.5
+
+# The joints of the upper-body model, (15,) bool: a track reporting no other joint is scored on them.
+_UPPER = np.isin(JOINTS, UPPER_JOINTS)
 
 # Cost of an impossible pairing (no common frame) in the assignment problem; far above
 # any real mean distance in metres, so the solver pairs as many feasible pairs as it can.
@@ -192,14 +203,16 @@ def score(
     """Score tracked skeletons against ground truth, person by person.
 
     Tracks are matched to people with `match_tracks`. For each person, the evaluated
-    joints are those the matched track reports in at least one frame (the upper-body
-    model reports 9 of the 15); the other joints are left out of both sides. A frame
-    counts when ground truth has at least one evaluated joint and at least one of the
-    person's joints is visible (for the visible-only row: at least one visible evaluated
-    joint), and is missed when the track has no
-    evaluated joint in it (a frame where both have joints but none in common has no
-    error and is left out). A person without a track is missed in every counted frame
-    (evaluated joints: all 15).
+    joints are all 15, or the 9 of the upper-body model (`occupose.joints.UPPER_JOINTS`)
+    when the matched track reports none of the others (no hip, knee or ankle) in any
+    frame; the other joints are left out of both sides. A frame counts when ground truth
+    has at least one evaluated joint and at least one of the person's joints is visible
+    (for the visible-only row: at least one visible evaluated joint), and is missed when
+    the track has no evaluated joint in it. In a frame the track has, an evaluated joint
+    that ground truth has (for the visible-only row: has visible) and the track does not
+    counts as an error of ``MISSED_ERROR_M`` (1 m), so leaving joints out never improves
+    a score. A person without a track is missed in every counted frame (evaluated joints:
+    all 15).
 
     Parameters
     ----------
@@ -231,7 +244,8 @@ def score(
             evaluated = np.ones(num_joints, dtype=bool)
         else:
             est = tracks[track_id]
-            evaluated = np.any(np.all(np.isfinite(est), axis=2), axis=0)
+            reported = np.any(np.all(np.isfinite(est), axis=2), axis=0)
+            evaluated = _UPPER if not reported[~_UPPER].any() else np.ones(num_joints, dtype=bool)
         gt = gt_joints[:, person, evaluated]
         est = est[:, evaluated]
         visible = gt_visible[:, person, evaluated]
@@ -239,6 +253,8 @@ def score(
         gt_known = np.all(np.isfinite(gt), axis=2) & in_sight
         has_estimate = np.any(np.all(np.isfinite(est), axis=2), axis=1)
         errors = joint_errors(gt, est)
+        errors[np.all(np.isfinite(gt), axis=2) & ~np.all(np.isfinite(est), axis=2) & has_estimate[:, None]] = \
+            MISSED_ERROR_M
         rows = []
         for counted in (gt_known, gt_known & visible):
             missed = np.any(counted, axis=1) & ~has_estimate
