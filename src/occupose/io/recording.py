@@ -26,6 +26,7 @@ import math
 import os
 import re
 import stat
+import sys
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -280,7 +281,7 @@ def _read_header(file: Path) -> tuple[float, int, list[Camera]]:
     if unknown:
         raise RecordingError(f"{file}: unknown key(s) {unknown}; a recording has exactly {list(RECORDING_KEYS)}")
     fps, num_frames, entries = header["fps"], header["num_frames"], header["cameras"]
-    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not math.isfinite(fps) or fps <= 0:
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0 < fps <= sys.float_info.max:
         raise RecordingError(f"{file}: \"fps\" must be a positive number, got {fps!r}")
     if isinstance(num_frames, bool) or not isinstance(num_frames, int) or num_frames < 0:
         raise RecordingError(f"{file}: \"num_frames\" must be a non-negative integer, got {num_frames!r}")
@@ -329,7 +330,7 @@ def _read_png(file: Path, kind: str, camera: Camera, *, decode: bool = True) -> 
     """The image of ``file``, a PNG of ``kind`` (a key of `_IMAGES`) of ``camera``'s size.
 
     Mode and size are checked from the PNG header before anything is decoded (an image
-    PIL takes for a decompression bomb is refused the same way). Returns (H, W) uint16,
+    over twice PIL's decompression-bomb limit is refused without its size). Returns (H, W) uint16,
     (H, W, 3) uint8 or (H, W) uint8 as the kind's mode says, or None when ``decode`` is
     False (the header checked only).
     """
@@ -341,10 +342,13 @@ def _read_png(file: Path, kind: str, camera: Camera, *, decode: bool = True) -> 
     except FileNotFoundError:
         raise FileNotFoundError(f"{file}: missing frame file") from None
     try:
-        with warnings.catch_warnings():  # PIL warns of images over its limit; it is an error here
-            warnings.simplefilter("error", Image.DecompressionBombWarning)
-            image = Image.open(file)
-        with image:
+        handle = open(file, "rb")
+    except OSError as problem:  # permission denied, a link loop
+        raise RecordingError(f"{file}: cannot read it ({problem.strerror or problem}); expected {expected}") from None
+    try:
+        with handle, warnings.catch_warnings():  # the size is checked below, before anything is decoded
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            image = Image.open(handle)
             if image.format != "PNG" or image.mode != mode:
                 raise RecordingError(
                     f"{file}: expected {what} PNG (mode {mode!r}), got a {image.format} image of mode {image.mode!r}"
@@ -356,9 +360,11 @@ def _read_png(file: Path, kind: str, camera: Camera, *, decode: bool = True) -> 
             return np.asarray(image) if decode else None
     except RecordingError:
         raise
-    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as error:
+    except Image.DecompressionBombError as error:
         raise RecordingError(f"{file}: far too large an image for a frame; expected {expected} ({error})") from None
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
+    except UnidentifiedImageError:
+        raise RecordingError(f"{file}: not a readable PNG image (cannot identify image file)") from None
+    except (OSError, SyntaxError, ValueError) as error:
         raise RecordingError(f"{file}: not a readable PNG image ({error})") from None
 
 
