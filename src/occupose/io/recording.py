@@ -25,7 +25,6 @@ import json
 import math
 import os
 import re
-import stat
 import sys
 import warnings
 from dataclasses import dataclass
@@ -379,15 +378,8 @@ class Recording:
 
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
-        try:
-            if not stat.S_ISDIR(os.stat(self.path).st_mode):
-                raise RecordingError(f"{self.path}: is not a folder; a recording is a folder")
-        except FileNotFoundError:
-            raise FileNotFoundError(f"{self.path}: no such recording folder") from None
-        except OSError as problem:
-            raise RecordingError(
-                f"{self.path}: cannot read the recording folder ({problem.strerror or problem})"
-            ) from None
+        if not self.path.is_dir():
+            raise FileNotFoundError(f"{self.path}: no such recording folder")
         self.fps, self.num_frames, self.cameras = _read_header(self.path / _JSON_NAME)
         self._by_name = {c.name: c for c in self.cameras}
         self._color_names = []
