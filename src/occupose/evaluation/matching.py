@@ -156,6 +156,38 @@ def identity_switches(gt: Any, tracks: Mapping[Any, Any], *, gate_m: float = 0.5
     return switches
 
 
+def person_errors(gt: np.ndarray, gt_visible: np.ndarray, est: np.ndarray | None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The joint errors of one person against its track, as `score` counts them.
+
+    Parameters
+    ----------
+    gt : (T, 15, 3) float64, metres; NaN where the person (or a joint) is absent.
+    gt_visible : (T, 15) bool, ground-truth visibility.
+    est : (T, 15, 3) float64 metres, NaN where not reported; None for no track.
+
+    Returns
+    -------
+    errors : (T, E) float64, metres, over the E evaluated joints (`score`): the distance
+        where both have the joint, ``MISSED_ERROR_M`` where ground truth has it and the
+        track, in a frame it has, does not; NaN elsewhere (a frame without the track).
+    known : (T, E) bool, ground truth has the joint and some joint of the person is visible.
+    evaluated : (15,) bool, the evaluated joints.
+    """
+    if est is None:
+        est = np.full(gt.shape, np.nan)
+        evaluated = np.ones(gt.shape[1], dtype=bool)
+    else:
+        reported = np.any(np.all(np.isfinite(est), axis=2), axis=0)
+        evaluated = _UPPER if not reported[~_UPPER].any() else np.ones(gt.shape[1], dtype=bool)
+    gt, est = gt[:, evaluated], est[:, evaluated]
+    gt_has, est_has = np.all(np.isfinite(gt), axis=2), np.all(np.isfinite(est), axis=2)
+    errors = joint_errors(gt, est)
+    errors[gt_has & ~est_has & est_has.any(axis=1)[:, None]] = MISSED_ERROR_M
+    known = gt_has & np.any(gt_visible, axis=1)[:, None]
+    return errors, known, evaluated
+
+
 @dataclass(frozen=True)
 class PersonScore:
     """Scores of one ground-truth person.
@@ -239,24 +271,11 @@ def score(
     persons = []
     for person in range(num_people):
         track_id = track_of.get(person)
-        if track_id is None:
-            est = np.full((num_frames, num_joints, 3), np.nan)
-            evaluated = np.ones(num_joints, dtype=bool)
-        else:
-            est = tracks[track_id]
-            reported = np.any(np.all(np.isfinite(est), axis=2), axis=0)
-            evaluated = _UPPER if not reported[~_UPPER].any() else np.ones(num_joints, dtype=bool)
-        gt = gt_joints[:, person, evaluated]
-        est = est[:, evaluated]
-        visible = gt_visible[:, person, evaluated]
-        in_sight = np.any(gt_visible[:, person], axis=1)[:, None]
-        gt_known = np.all(np.isfinite(gt), axis=2) & in_sight
-        has_estimate = np.any(np.all(np.isfinite(est), axis=2), axis=1)
-        errors = joint_errors(gt, est)
-        errors[np.all(np.isfinite(gt), axis=2) & ~np.all(np.isfinite(est), axis=2) & has_estimate[:, None]] = \
-            MISSED_ERROR_M
+        est = None if track_id is None else tracks[track_id]
+        errors, known, evaluated = person_errors(gt_joints[:, person], gt_visible[:, person], est)
+        has_estimate = np.isfinite(errors).any(axis=1)
         rows = []
-        for counted in (gt_known, gt_known & visible):
+        for counted in (known, known & gt_visible[:, person, evaluated]):
             missed = np.any(counted, axis=1) & ~has_estimate
             rows.append(table_row(frame_errors(errors, counted), fps, missed=missed))
         names = [name for name, keep in zip(JOINTS, evaluated) if keep]
