@@ -156,6 +156,16 @@ def identity_switches(gt: Any, tracks: Mapping[Any, Any], *, gate_m: float = 0.5
     return switches
 
 
+def evaluated_joints(est: np.ndarray | None) -> np.ndarray:
+    """(15,) bool, the joints a track is scored on (`score`): the upper-body model's 9 when
+    ``est`` ((T, 15, 3) metres, NaN where not reported) reports no hip, knee or ankle in
+    any frame, else all 15 (also for no track, None)."""
+    if est is None:
+        return np.ones(NUM_JOINTS, dtype=bool)
+    reported = np.any(np.all(np.isfinite(est), axis=2), axis=0)
+    return _UPPER.copy() if not reported[~_UPPER].any() else np.ones(NUM_JOINTS, dtype=bool)
+
+
 def person_errors(gt: np.ndarray, gt_visible: np.ndarray, est: np.ndarray | None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The joint errors of one person against its track, as `score` counts them.
@@ -174,12 +184,8 @@ def person_errors(gt: np.ndarray, gt_visible: np.ndarray, est: np.ndarray | None
     known : (T, E) bool, ground truth has the joint and some joint of the person is visible.
     evaluated : (15,) bool, the evaluated joints.
     """
-    if est is None:
-        est = np.full(gt.shape, np.nan)
-        evaluated = np.ones(gt.shape[1], dtype=bool)
-    else:
-        reported = np.any(np.all(np.isfinite(est), axis=2), axis=0)
-        evaluated = _UPPER if not reported[~_UPPER].any() else np.ones(gt.shape[1], dtype=bool)
+    evaluated = evaluated_joints(est)
+    est = np.full(gt.shape, np.nan) if est is None else est
     gt, est = gt[:, evaluated], est[:, evaluated]
     gt_has, est_has = np.all(np.isfinite(gt), axis=2), np.all(np.isfinite(est), axis=2)
     errors = joint_errors(gt, est)
