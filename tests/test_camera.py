@@ -69,6 +69,8 @@ def test_to_dict_matches_the_recording_json_entry_and_round_trips():
         ({"depth_scale": 0.0}, "depth_scale must be a positive"),
         ({"name": ""}, "non-empty string"),
         ({"name": "a/b"}, "folder name"),
+        ({"fx": 10 ** 400}, "fx must be a positive finite number"),  # beyond any float: no OverflowError
+        ({"cy": -(10 ** 400)}, "cy must be a finite number"),
     ],
 )
 def test_camera_rejects_bad_values(change, message):
@@ -85,8 +87,13 @@ def test_camera_rejects_bad_values(change, message):
         (np.diag([1.0, 1.0, 1.0, 2.0]), "last row"),
         (np.diag([1.0, 1.1, 1.0, 1.0]), "not rigid"),
         (np.diag([1.0, 1.0, -1.0, 1.0]), r"det\(R\) = -1"),
+        # R^T R overflows to inf - inf = NaN: still not rigid, and no RuntimeWarning
+        (np.block([[np.array([[1, -1, 1], [1, 1, -1], [-1, 1, 1]]) * 1e200, np.zeros((3, 1))],
+                   [np.zeros((1, 3)), np.ones((1, 1))]]), "not rigid"),
+        ([[10 ** 400, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "must be a \\(4, 4\\) array of numbers"),
     ],
 )
+@pytest.mark.filterwarnings("error")
 def test_camera_rejects_non_rigid_poses(pose, message):
     with pytest.raises(ValueError, match=message):
         small_camera(pose)

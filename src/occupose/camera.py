@@ -35,14 +35,15 @@ def _check_rigid(matrix: np.ndarray, what: str) -> None:
     if np.max(np.abs(matrix[3] - (0.0, 0.0, 0.0, 1.0))) > _RIGID_TOL:
         raise ValueError(f"{what} must have last row [0, 0, 0, 1], got {matrix[3].tolist()}")
     rotation = matrix[:3, :3]
-    error = np.max(np.abs(rotation.T @ rotation - np.eye(3)))
-    if error > _RIGID_TOL:
+    with np.errstate(over="ignore", invalid="ignore"):  # entries near the float limit: not rigid, no warning
+        error = np.max(np.abs(rotation.T @ rotation - np.eye(3)))
+        det = np.linalg.det(rotation)
+    if not error <= _RIGID_TOL:  # NaN (inf - inf) fails too
         raise ValueError(
             f"{what} is not rigid: its rotation block is not orthonormal "
             f"(max |R^T R - I| = {error:.3g}, tolerance {_RIGID_TOL:g})"
         )
-    det = np.linalg.det(rotation)
-    if abs(det - 1.0) > _RIGID_TOL:
+    if not abs(det - 1.0) <= _RIGID_TOL:
         raise ValueError(f"{what} is not a proper rotation: det(R) = {det:.6g}, expected +1")
 
 
@@ -55,7 +56,10 @@ def _positive_int(value: Any, what: str) -> int:
 def _finite_float(value: Any, what: str, *, positive: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"{what} must be a number, got {value!r}")
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond the largest float
+        number = math.inf
     if not math.isfinite(number) or (positive and number <= 0.0):
         raise ValueError(f"{what} must be a {'positive ' if positive else ''}finite number, got {value!r}")
     return number
@@ -109,7 +113,7 @@ class Camera:
             object.__setattr__(self, key, _finite_float(getattr(self, key), f"camera {self.name!r}: {key}"))
         try:
             pose = np.array(self.world_from_camera, dtype=np.float64)
-        except (TypeError, ValueError) as error:
+        except (TypeError, ValueError, OverflowError) as error:
             raise ValueError(
                 f"camera {self.name!r}: world_from_camera must be a (4, 4) array of numbers ({error})"
             ) from None

@@ -102,13 +102,12 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
               help="A tracks.csv to draw beside the ground truth.")
 def show_cmd(recording, index, out, tracks) -> None:
     """Write a PNG of one frame: depth colour-mapped, skeletons drawn over it."""
-    from occupose.io.joint_table import read_tracks_csv
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
     try:
         rec = Recording(recording)
-        track_data = read_tracks_csv(tracks, rec.num_frames) if tracks else None
+        track_data = _read_tracks(tracks, rec.num_frames, allow_unmarked=True) if tracks else None
         path = show_frame(rec, index, out, track_data)
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
@@ -118,33 +117,55 @@ def show_cmd(recording, index, out, tracks) -> None:
 @main.command("score")
 @click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.argument("tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-def score_cmd(recording, tracks) -> None:
+@click.option("--unmarked", is_flag=True, help="Score a tracks.csv without the end line occupose writes (one "
+              "another program wrote), with a warning: a file cut short at a line boundary looks the same.")
+def score_cmd(recording, tracks, unmarked) -> None:
     """Print the Table I row of TRACKS (a tracks.csv) against RECORDING's ground truth."""
     from occupose.io.recording import Recording
 
     try:
-        click.echo(score_text(Recording(recording), tracks))
+        click.echo(score_text(Recording(recording), tracks, allow_unmarked=unmarked))
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
 
 
-def score_text(rec, tracks_path: Path) -> str:
-    """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person."""
+def _read_tracks(path: Path, num_frames: int, allow_unmarked: bool = False):
+    """read_tracks_csv, its warning (a file without the end line) printed to stderr."""
+    import warnings
+
+    from occupose.io.joint_table import UnmarkedTableWarning, read_tracks_csv
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UnmarkedTableWarning)
+        tracks = read_tracks_csv(path, num_frames, allow_unmarked=allow_unmarked)
+    for warning in caught:
+        click.echo(f"warning: {warning.message}", err=True)
+    return tracks
+
+
+def score_text(rec, tracks_path: Path, allow_unmarked: bool = False) -> str:
+    """Table I rows (all joints and ground-truth-visible joints) for each ground-truth person.
+    ``allow_unmarked``: read a tracks.csv without its end line (`_read_tracks`)."""
     from occupose.evaluation.matching import score
     from occupose.evaluation.report import TABLE_COLUMNS, markdown_table, table_i_cells
-    from occupose.io.joint_table import read_tracks_csv
+    from occupose.joints import NUM_JOINTS
 
-    if not rec.has_groundtruth:
-        raise ValueError(f"{rec.path}: no groundtruth.csv, nothing to score against")
-    gt = rec.groundtruth()
-    tracks = read_tracks_csv(tracks_path, rec.num_frames)
+    try:
+        gt = rec.groundtruth()  # a RecordingError for a folder or an unreadable file of that name
+    except FileNotFoundError:
+        raise ValueError(f"{rec.path}: no groundtruth.csv, nothing to score against") from None
+    tracks = _read_tracks(tracks_path, rec.num_frames, allow_unmarked)
     result = score(gt.joints, gt.visible, {k: v[0] for k, v in tracks.items()}, rec.fps)
     rows = []
+    notes = []
     for pid, person in zip(gt.person_ids, result.persons):
         track = "none" if person.track is None else f"track {person.track}"
         rows.append([f"person {pid} ({track}) all joints", *table_i_cells(person.all_joints)])
         rows.append([f"person {pid} ({track}) visible joints", *table_i_cells(person.visible_joints)])
-    lines = [markdown_table(["person", *TABLE_COLUMNS], rows, text_columns=1)]
+        if len(person.per_joint_cm) < NUM_JOINTS:
+            notes.append(f"person {pid} ({track}): scored on the {len(person.per_joint_cm)} upper-body joints "
+                         "(the track has no hip, knee or ankle)")
+    lines = [markdown_table(["person", *TABLE_COLUMNS], rows, text_columns=1), *notes]
     lines.append(f"identity switches: {result.identity_switches}; unmatched tracks: "
                  f"{list(result.unmatched_tracks) or 'none'}")
     return "\n".join(lines)

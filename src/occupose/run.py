@@ -106,7 +106,8 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
         thread competes with the likelihood kernels' two threads (benchmarks/bench_speed.py)
     With ``grid.noise_model`` measured, each camera's noise is measured from the first
     ``grid.noise_frames`` frames first (:func:`occupose.grid.noise.measure_noise`).
-    An empty recording (no frames) gives an empty result.
+    An empty recording (no frames) gives an empty result. Only depth is read: the tracker
+    takes no colour (the colour images were checked when the recording was opened).
     """
     from occupose.io.recording import Recording
 
@@ -118,10 +119,10 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     config = method_config(config) if isinstance(config, str) else config
     noise = None
     if config.grid.noise_model == "measured":
-        first = (frame.depth for frame in itertools.islice(recording.frames(), config.grid.noise_frames))
+        first = (frame.depth for frame in itertools.islice(recording.frames(color=False), config.grid.noise_frames))
         noise = measure_noise(recording.cameras, first, config.grid)
     tracker = Tracker(recording.cameras, recording.fps, config, seed=seed, noise=noise)
-    return track_frames(tracker, recording.frames(), recording.num_frames, progress, overlap=overlap)
+    return track_frames(tracker, recording.frames(color=False), recording.num_frames, progress, overlap=overlap)
 
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:

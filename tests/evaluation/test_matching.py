@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from occupose.evaluation.matching import identity_switches, match_tracks, score
-from occupose.joints import UPPER_JOINTS
+from occupose.joints import JOINTS, UPPER_JOINTS
 
 
 # --------------------------------------------------------------------------- tracks vs people
@@ -117,3 +117,32 @@ def test_frames_before_anything_of_the_person_is_visible_are_not_scored():
     person = score(gt, visible, {1: track}, fps=30.0).persons[0]
     assert person.all_joints.frames == 60 and person.all_joints.coverage == pytest.approx(95.0)
     assert not person.all_joints.fail and person.all_joints.mean_cm == 0.0
+
+
+def test_joints_left_out_count_as_missed_and_never_improve_a_score():
+    gt = _full_people()[:, :1]
+    visible = np.ones(gt.shape[:3], dtype=bool)
+    full = gt[:, 0] + [0.05, 0.0, 0.0]  # 5 cm on every joint ...
+    full[:, JOINTS.index("pelvis")] = gt[:, 0, JOINTS.index("pelvis")]  # ... but the pelvis exact
+    pelvis_only = np.full_like(full, np.nan)
+    pelvis_only[:, JOINTS.index("pelvis")] = full[:, JOINTS.index("pelvis")]
+    whole, pelvis = (score(gt, visible, {1: est}, fps=10.0).persons[0] for est in (full, pelvis_only))
+    assert whole.all_joints.mean_cm == pytest.approx(14 * 5.0 / 15) and not whole.all_joints.fail
+    # the pelvis alone is an upper-body track (no hip, knee or ankle): 8 of its 9 joints missed
+    assert list(pelvis.per_joint_cm) == list(UPPER_JOINTS)
+    assert pelvis.all_joints.mean_cm == pytest.approx(8 * 100.0 / 9) and pelvis.all_joints.fail
+    assert pelvis.per_joint_cm["head"] == pytest.approx(100.0) and pelvis.per_joint_cm["pelvis"] == 0.0
+    assert pelvis.visible_joints.mean_cm == pytest.approx(8 * 100.0 / 9)
+    # a full-body track that drops its left leg in frames 10-19: 3 of 15 joints at 1 m there
+    dropped = full.copy()
+    dropped[10:20, [JOINTS.index(j) for j in ("left_hip", "left_knee", "left_ankle")]] = np.nan
+    row = score(gt, visible, {1: dropped}, fps=10.0).persons[0].all_joints
+    assert row.coverage == 100.0 and row.over20 == pytest.approx(100 / 3)
+    assert row.mean_cm == pytest.approx((20 * 14 * 5.0 / 15 + 10 * (11 * 5.0 + 3 * 100.0) / 15) / 30)
+    # a joint hidden in the ground truth and left out is no miss in the visible-only row
+    visible[:, 0, JOINTS.index("left_ankle")] = False
+    no_ankle = full.copy()
+    no_ankle[:, JOINTS.index("left_ankle")] = np.nan
+    person = score(gt, visible, {1: no_ankle}, fps=10.0).persons[0]
+    assert person.visible_joints.mean_cm == pytest.approx(13 * 5.0 / 14)
+    assert person.all_joints.mean_cm == pytest.approx((13 * 5.0 + 100.0) / 15)

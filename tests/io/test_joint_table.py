@@ -7,6 +7,7 @@ from occupose.io.joint_table import (
     GROUNDTRUTH_COLUMNS,
     TRACKS_COLUMNS,
     JointTableError,
+    UnmarkedTableWarning,
     read_joint_table,
     read_tracks_csv,
     write_joint_table,
@@ -29,13 +30,15 @@ def _table():
 
 # The bytes the writers wrote before there was one module (metrics.write_tracks_csv and
 # RecordingWriter.write_groundtruth at 6b268f5) for _table(): rows by frame, then id, then
-# joint; 6 decimals for tracks, 5 for ground truth; "\n" line ends.
+# joint; 6 decimals for tracks, 5 for ground truth; "\n" line ends; since issue 26 tracks
+# end with the number of rows.
 GOLDEN_TRACKS = (
     "frame,track,joint,x,y,z,visible\n"
     "0,4,head,1.250000,-0.000000,2.000001,1\n"
     "0,4,pelvis,-1.500000,0.123456,3.000000,0\n"
     "1,2,right_ankle,0.000000,-0.000000,1.000000,1\n"
     "1,4,head,0.500000,0.000000,-12.345679,0\n"
+    "# end: 4 rows\n"
 )
 GOLDEN_GROUNDTRUTH = (
     "frame,person,joint,x,y,z,visible\n"
@@ -67,7 +70,9 @@ def test_round_trip(tmp_path, rng, kind):
     lines = path.read_text().splitlines()
     assert lines[0] == f"frame,{'track' if kind == 'tracks' else 'person'},joint,x,y,z,visible"
     assert lines[1].startswith("0,3,head,")  # frame, then id, then joint order
-    assert len(lines) == 1 + 4 * 15 + 3 * 9
+    assert len(lines) == 1 + 4 * 15 + 3 * 9 + (kind == "tracks")
+    if kind == "tracks":
+        assert lines[-1] == f"# end: {4 * 15 + 3 * 9} rows"
 
     table = read_joint_table(path, 4, kind)
     assert list(table) == [3, 12]  # in the order of their first row
@@ -121,6 +126,61 @@ def test_not_utf8_is_an_error_naming_the_file(tmp_path):
         read_tracks_csv(path, 5)
 
 
+def test_a_tracks_file_cut_short_or_with_rows_lost_is_refused(tmp_path):
+    path = tmp_path / "tracks.csv"
+    write_tracks_csv(path, _table())
+    lines = path.read_text().splitlines(keepends=True)
+    cut = tmp_path / "cut.csv"
+    cut.write_text("".join(lines[:3]))  # at a line boundary: header and 2 of the 4 rows
+    with pytest.raises(JointTableError, match=r"cut.csv: no end line \('# end: 2 rows'\) after its 2 rows"):
+        read_tracks_csv(cut, 2)
+    with pytest.warns(UnmarkedTableWarning, match="cut.csv: no end line"):
+        table = read_tracks_csv(cut, 2, allow_unmarked=True)
+    assert list(table) == [4] and np.isfinite(table[4][0][..., 0]).sum() == 2
+    gap = tmp_path / "gap.csv"
+    gap.write_text("".join(lines[:2] + lines[3:]))  # the end line kept, a row lost
+    with pytest.raises(JointTableError, match="gap.csv: its end line says 4 rows, the file has 3"):
+        read_tracks_csv(gap, 2, allow_unmarked=True)
+    after = tmp_path / "after.csv"
+    after.write_text("".join(lines + lines[1:2]))
+    with pytest.raises(JointTableError, match="after.csv, line 7: text after the end line"):
+        read_tracks_csv(after, 2)
+    comment = tmp_path / "comment.csv"
+    comment.write_text("".join(lines[:2] + ["# made by hand\n"] + lines[2:]))
+    with pytest.raises(JointTableError, match=r"comment.csv, line 3: a comment line; the only one allowed is the last"):
+        read_tracks_csv(comment, 2)
+
+
+def test_ground_truth_needs_no_end_line_but_one_is_checked(tmp_path):
+    path = tmp_path / "groundtruth.csv"
+    write_joint_table(path, _table(), "groundtruth")
+    assert not path.read_text().startswith("#") and "#" not in path.read_text()
+    assert len(read_joint_table(path, 2, "groundtruth")) == 2
+    path.write_text(path.read_text() + "# end: 5 rows\n")
+    with pytest.raises(JointTableError, match="its end line says 5 rows, the file has 4"):
+        read_joint_table(path, 2, "groundtruth")
+
+
+def test_a_byte_order_mark_and_crlf_line_ends_are_read(tmp_path):
+    path = tmp_path / "tracks.csv"
+    write_tracks_csv(path, _table())
+    expected = read_tracks_csv(path, 2)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes().replace(b"\n", b"\r\n"))
+    table = read_tracks_csv(path, 2)
+    assert list(table) == list(expected)
+    for ident in table:
+        np.testing.assert_array_equal(table[ident][0], expected[ident][0])
+        np.testing.assert_array_equal(table[ident][1], expected[ident][1])
+
+
+def test_a_folder_or_a_device_is_an_error_naming_it(tmp_path):
+    (tmp_path / "tracks.csv").mkdir()
+    with pytest.raises(JointTableError, match="tracks.csv: is a folder; expected a tracks CSV file"):
+        read_tracks_csv(tmp_path / "tracks.csv", 2)
+    with pytest.raises(JointTableError, match="/dev/zero: is a device, pipe or socket; expected a tracks CSV file"):
+        read_tracks_csv("/dev/zero", 2)
+
+
 def test_visible_column_is_optional_in_ground_truth_only(tmp_path):
     path = tmp_path / "groundtruth.csv"
     path.write_text("frame,person,joint,x,y,z\n1,4,neck,0.1,0.2,1.5\n")
@@ -135,7 +195,7 @@ def test_missing_file_empty_table_and_bad_arguments(tmp_path):
         read_tracks_csv(tmp_path / "nothing.csv", num_frames=5)
     path = tmp_path / "tracks.csv"
     write_tracks_csv(path, {})
-    assert path.read_text() == "frame,track,joint,x,y,z,visible\n"
+    assert path.read_text() == "frame,track,joint,x,y,z,visible\n# end: 0 rows\n"
     assert read_tracks_csv(path, num_frames=5) == {}
     with pytest.raises(ValueError, match="num_frames must be an integer >= 0, got -1"):
         read_tracks_csv(path, num_frames=-1)

@@ -442,3 +442,21 @@ def test_real_azure_kinect_frame_round_trips(tmp_path):
     points, pixels = points_from_depth(recording.frame(0).depth["cam0"], camera, frame="camera")
     assert pixels.size == np.count_nonzero(depth)  # 23.5 % of the pixels are invalid zeros
     assert 0.16 < points[:, 2].min() and points[:, 2].max() < 3.7
+
+
+def test_colour_is_left_undecoded_when_not_asked_for(rec):
+    file = rec / "cam0" / "color" / "000001.png"
+    data = file.read_bytes()
+    at = data.index(b"IDAT") + 8
+    file.write_bytes(data[:at] + bytes(b ^ 0xFF for b in data[at:at + 16]) + data[at + 16:])  # header intact
+    recording = Recording(rec)  # the headers are checked, not the image data
+    with pytest.raises(RecordingError, match="000001.png: not a readable PNG image"):
+        recording.frame(1)
+    frame = recording.frame(1, color=False)
+    assert frame.color == {} and frame.depth["cam0"].shape == (6, 8)
+    assert [f.index for f in recording.frames(color=False)] == [0, 1, 2]
+
+
+def test_frame_files_past_num_frames_are_refused(rec):
+    (rec / "top" / "depth" / "000003.png").write_bytes((rec / "top" / "depth" / "000002.png").read_bytes())
+    expect_error(rec, rec / "top" / "depth", r"1 frame file\(s\) past the recording's \"num_frames\" 3 \(000003.png\)")

@@ -25,7 +25,15 @@ from occupose.evaluation.errors import (
     table_row,
 )
 from occupose.evaluation.evaluate import Evaluation, run_method
-from occupose.evaluation.matching import PersonScore, Score, identity_switches, match_tracks, score
+from occupose.evaluation.matching import (
+    PersonScore,
+    Score,
+    evaluated_joints,
+    identity_switches,
+    match_tracks,
+    person_errors,
+    score,
+)
 from occupose.evaluation.pixels import (
     arm_epsilons,
     foreground_scores,
@@ -52,7 +60,8 @@ __all__ = [
     "TableRow", "fail_curve", "frame_errors", "is_fail", "joint_errors", "per_joint_errors", "rolling_mean",
     "table_row",
     # matching
-    "PersonScore", "Score", "identity_switches", "match_tracks", "score",
+    "PersonScore", "Score", "evaluated_joints", "identity_switches", "match_tracks", "person_errors",
+    "score",
     # pixels
     "arm_epsilons", "foreground_scores", "pixel_assignment_accuracy", "segment_distances",
     # report

@@ -9,7 +9,9 @@ joint error
     is missing (NaN).
 frame error ``D_t``
     Mean of the joint errors of frame ``t`` over the joints that count (finite error,
-    and inside the optional mask, e.g. ground-truth-visible joints only).
+    and inside the optional mask, e.g. ground-truth-visible joints only). In a scored
+    sequence (`occupose.evaluation.matching.score`) a joint that ground truth has and the
+    track leaves out, in a frame the track has, has the error ``MISSED_ERROR_M``.
 counted, estimated, missed and excluded frames
     A frame counts for a person when ground truth has the person and at least one of
     their joints is visible to a camera (`occupose.evaluation.matching.score`; a person

@@ -40,8 +40,8 @@ from typing import Any
 import numpy as np
 
 from occupose._validate import positive_int
-from occupose.evaluation.errors import frame_errors, joint_errors
-from occupose.evaluation.matching import match_tracks, score
+from occupose.evaluation.errors import frame_errors
+from occupose.evaluation.matching import match_tracks, person_errors, score
 from occupose.evaluation.pixels import ARM_PARTS, arm_epsilons
 from occupose.evaluation.report import RunResult, report_markdown, write_plots, write_results_csv
 
@@ -176,15 +176,12 @@ def _tracked_arm_epsilons(gt_joints: np.ndarray, arms: list[list[np.ndarray]],
 
 def _tracked_frame_errors(gt_joints: np.ndarray, gt_visible: np.ndarray, tracks: dict[int, np.ndarray]) -> np.ndarray:
     """(T, P) D_t of each person against its matched track, as matching.score counts it
-    (joints the track reports, frames where some joint of the person is visible)."""
+    (`occupose.evaluation.matching.person_errors`)."""
     num_frames, num_people = gt_joints.shape[:2]
     out = np.full((num_frames, num_people), np.nan)
     for track_id, person in match_tracks(gt_joints, tracks).items():
-        est = tracks[track_id]
-        evaluated = np.any(np.all(np.isfinite(est), axis=2), axis=0)
-        gt = gt_joints[:, person, evaluated]
-        counted = np.all(np.isfinite(gt), axis=2) & np.any(gt_visible[:, person], axis=1)[:, None]
-        out[:, person] = frame_errors(joint_errors(gt, est[:, evaluated]), counted)
+        errors, known, _ = person_errors(gt_joints[:, person], gt_visible[:, person], tracks[track_id])
+        out[:, person] = frame_errors(errors, known)
     return out
 
 

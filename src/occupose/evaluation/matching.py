@@ -14,12 +14,23 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from occupose._validate import bool_array, positive_float
-from occupose.evaluation.errors import TableRow, _nanmean, frame_errors, joint_errors, per_joint_errors, table_row
-from occupose.joints import JOINTS, NUM_JOINTS
+from occupose.evaluation.errors import (
+    MISSED_ERROR_M,
+    TableRow,
+    _nanmean,
+    frame_errors,
+    joint_errors,
+    per_joint_errors,
+    table_row,
+)
+from occupose.joints import JOINTS, NUM_JOINTS, UPPER_JOINTS
 
 #: Cost of a frame where a person has ground truth and a track has no estimate, when
 #: matching tracks to people (metres, as a mean joint distance).
 ABSENT_COST_M = 0.5
+
+# The joints of the upper-body model, (15,) bool: a track reporting no other joint is scored on them.
+_UPPER = np.isin(JOINTS, UPPER_JOINTS)
 
 # Cost of an impossible pairing (no common frame) in the assignment problem; far above
 # any real mean distance in metres, so the solver pairs as many feasible pairs as it can.
@@ -145,6 +156,44 @@ def identity_switches(gt: Any, tracks: Mapping[Any, Any], *, gate_m: float = 0.5
     return switches
 
 
+def evaluated_joints(est: np.ndarray | None) -> np.ndarray:
+    """(15,) bool, the joints a track is scored on (`score`): the upper-body model's 9 when
+    ``est`` ((T, 15, 3) metres, NaN where not reported) reports no hip, knee or ankle in
+    any frame, else all 15 (also for no track, None)."""
+    if est is None:
+        return np.ones(NUM_JOINTS, dtype=bool)
+    reported = np.any(np.all(np.isfinite(est), axis=2), axis=0)
+    return _UPPER.copy() if not reported[~_UPPER].any() else np.ones(NUM_JOINTS, dtype=bool)
+
+
+def person_errors(gt: np.ndarray, gt_visible: np.ndarray, est: np.ndarray | None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The joint errors of one person against its track, as `score` counts them.
+
+    Parameters
+    ----------
+    gt : (T, 15, 3) float64, metres; NaN where the person (or a joint) is absent.
+    gt_visible : (T, 15) bool, ground-truth visibility.
+    est : (T, 15, 3) float64 metres, NaN where not reported; None for no track.
+
+    Returns
+    -------
+    errors : (T, E) float64, metres, over the E evaluated joints (`score`): the distance
+        where both have the joint, ``MISSED_ERROR_M`` where ground truth has it and the
+        track, in a frame it has, does not; NaN elsewhere (a frame without the track).
+    known : (T, E) bool, ground truth has the joint and some joint of the person is visible.
+    evaluated : (15,) bool, the evaluated joints.
+    """
+    evaluated = evaluated_joints(est)
+    est = np.full(gt.shape, np.nan) if est is None else est
+    gt, est = gt[:, evaluated], est[:, evaluated]
+    gt_has, est_has = np.all(np.isfinite(gt), axis=2), np.all(np.isfinite(est), axis=2)
+    errors = joint_errors(gt, est)
+    errors[gt_has & ~est_has & est_has.any(axis=1)[:, None]] = MISSED_ERROR_M
+    known = gt_has & np.any(gt_visible, axis=1)[:, None]
+    return errors, known, evaluated
+
+
 @dataclass(frozen=True)
 class PersonScore:
     """Scores of one ground-truth person.
@@ -192,14 +241,16 @@ def score(
     """Score tracked skeletons against ground truth, person by person.
 
     Tracks are matched to people with `match_tracks`. For each person, the evaluated
-    joints are those the matched track reports in at least one frame (the upper-body
-    model reports 9 of the 15); the other joints are left out of both sides. A frame
-    counts when ground truth has at least one evaluated joint and at least one of the
-    person's joints is visible (for the visible-only row: at least one visible evaluated
-    joint), and is missed when the track has no
-    evaluated joint in it (a frame where both have joints but none in common has no
-    error and is left out). A person without a track is missed in every counted frame
-    (evaluated joints: all 15).
+    joints are all 15, or the 9 of the upper-body model (`occupose.joints.UPPER_JOINTS`)
+    when the matched track reports none of the others (no hip, knee or ankle) in any
+    frame; the other joints are left out of both sides. A frame counts when ground truth
+    has at least one evaluated joint and at least one of the person's joints is visible
+    (for the visible-only row: at least one visible evaluated joint), and is missed when
+    the track has no evaluated joint in it. In a frame the track has, an evaluated joint
+    that ground truth has (for the visible-only row: has visible) and the track does not
+    counts as an error of ``MISSED_ERROR_M`` (1 m), so leaving joints out never improves
+    a score. A person without a track is missed in every counted frame (evaluated joints:
+    all 15).
 
     Parameters
     ----------
@@ -226,21 +277,11 @@ def score(
     persons = []
     for person in range(num_people):
         track_id = track_of.get(person)
-        if track_id is None:
-            est = np.full((num_frames, num_joints, 3), np.nan)
-            evaluated = np.ones(num_joints, dtype=bool)
-        else:
-            est = tracks[track_id]
-            evaluated = np.any(np.all(np.isfinite(est), axis=2), axis=0)
-        gt = gt_joints[:, person, evaluated]
-        est = est[:, evaluated]
-        visible = gt_visible[:, person, evaluated]
-        in_sight = np.any(gt_visible[:, person], axis=1)[:, None]
-        gt_known = np.all(np.isfinite(gt), axis=2) & in_sight
-        has_estimate = np.any(np.all(np.isfinite(est), axis=2), axis=1)
-        errors = joint_errors(gt, est)
+        est = None if track_id is None else tracks[track_id]
+        errors, known, evaluated = person_errors(gt_joints[:, person], gt_visible[:, person], est)
+        has_estimate = np.isfinite(errors).any(axis=1)
         rows = []
-        for counted in (gt_known, gt_known & visible):
+        for counted in (known, known & gt_visible[:, person, evaluated]):
             missed = np.any(counted, axis=1) & ~has_estimate
             rows.append(table_row(frame_errors(errors, counted), fps, missed=missed))
         names = [name for name, keep in zip(JOINTS, evaluated) if keep]

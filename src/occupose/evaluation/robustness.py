@@ -46,7 +46,7 @@ import numpy as np
 
 from occupose._validate import positive_float
 from occupose.evaluation.errors import joint_errors
-from occupose.evaluation.matching import score
+from occupose.evaluation.matching import evaluated_joints, score
 
 #: Distance under which a joint counts as found (ITOP's 10 cm rule), metres.
 WITHIN_M = 0.10
@@ -146,10 +146,10 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
             continue
         if person.track is None:
             est = np.full(gt_joints.shape[:1] + gt_joints.shape[2:], np.nan)
-            evaluated = np.ones(gt_joints.shape[2], dtype=bool)
+            evaluated = evaluated_joints(None)
         else:
             est = np.asarray(tracks[person.track], dtype=np.float64)
-            evaluated = np.any(np.all(np.isfinite(est), axis=2), axis=0)
+            evaluated = evaluated_joints(est)
         in_sight = np.any(gt_visible[:, index], axis=1)[:, None]
         visible = gt_visible[:, index][:, evaluated] & in_sight
         row = person.all_joints

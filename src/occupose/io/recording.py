@@ -10,7 +10,12 @@
 
 A camera has colour when its ``color`` folder exists; it then has a colour image for
 every frame. Ground truth has one row per frame, person and known joint; joints with
-no row are unknown (NaN); `occupose.io.joint_table` reads and writes it. Everything wrong with a recording is reported as a
+no row are unknown (NaN); `occupose.io.joint_table` reads and writes it.
+
+Opening a recording checks ``recording.json`` and every frame file's PNG header (mode and
+size; no image is decoded before its header is checked), and refuses frame files past
+``num_frames``. Everything wrong with a recording, an OS error reading it (permission
+denied, a folder or a device where a file should be) included, is reported as a
 RecordingError (a ValueError) or FileNotFoundError whose message names the file.
 """
 
@@ -19,6 +24,9 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
+import sys
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator, Mapping, Sequence
@@ -27,6 +35,7 @@ import numpy as np
 from PIL import Image, UnidentifiedImageError
 
 from occupose.camera import Camera, camera_from_dict
+from occupose.io._files import check_regular_file, read_file_bytes
 from occupose.io.joint_table import JointTableError, read_joint_table, write_joint_table
 from occupose.joints import NUM_JOINTS
 
@@ -41,6 +50,12 @@ _GROUNDTRUTH_NAME = "groundtruth.csv"
 
 #: Synthetic label images a recording may carry beside depth and colour.
 LABEL_KINDS = ("person", "part")
+
+# The images of a recording by kind: their PIL mode and what the messages call them.
+_IMAGES = {"depth": ("I;16", "a 16-bit grayscale depth"), "color": ("RGB", "an 8-bit RGB colour"),
+           **{kind: ("L", f"an 8-bit {kind} label") for kind in LABEL_KINDS}}
+# The name of a frame's image file (`frame_filename`), any frame number.
+_FRAME_NAME = re.compile(r"[0-9]{6,}\.png")
 
 
 class RecordingError(ValueError):
@@ -233,16 +248,22 @@ class RecordingWriter:
 
 
 def _read_header(file: Path) -> tuple[float, int, list[Camera]]:
-    if not file.is_file():
-        raise FileNotFoundError(f"{file}: no such file; a recording folder needs a {_JSON_NAME}")
     try:
-        header = json.loads(file.read_text(encoding="utf-8"))
+        data = read_file_bytes(file, RecordingError, "the recording's JSON header")
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{file}: no such file; a recording folder needs a {_JSON_NAME}") from None
+    try:
+        header = json.loads(data.decode("utf-8-sig"))
     except UnicodeDecodeError as error:
         raise RecordingError(f"{file}: not a UTF-8 text file ({error.reason})") from None
     except json.JSONDecodeError as error:
         raise RecordingError(
             f"{file}: not valid JSON ({error.msg} at line {error.lineno} column {error.colno})"
         ) from None
+    except RecursionError:
+        raise RecordingError(f"{file}: JSON nested too deeply to be a recording header") from None
+    except ValueError as error:  # an integer of more digits than Python converts (its advice cut)
+        raise RecordingError(f"{file}: not a readable recording header ({str(error).split(';')[0]})") from None
     if not isinstance(header, dict):
         raise RecordingError(f"{file}: expected a JSON object, got {type(header).__name__}")
     if header.get("format") != FORMAT:
@@ -259,7 +280,7 @@ def _read_header(file: Path) -> tuple[float, int, list[Camera]]:
     if unknown:
         raise RecordingError(f"{file}: unknown key(s) {unknown}; a recording has exactly {list(RECORDING_KEYS)}")
     fps, num_frames, entries = header["fps"], header["num_frames"], header["cameras"]
-    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not math.isfinite(fps) or fps <= 0:
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0 < fps <= sys.float_info.max:
         raise RecordingError(f"{file}: \"fps\" must be a positive number, got {fps!r}")
     if isinstance(num_frames, bool) or not isinstance(num_frames, int) or num_frames < 0:
         raise RecordingError(f"{file}: \"num_frames\" must be a non-negative integer, got {num_frames!r}")
@@ -277,39 +298,82 @@ def _read_header(file: Path) -> tuple[float, int, list[Camera]]:
     return float(fps), num_frames, cameras
 
 
-def _check_frame_files(folder: Path, num_frames: int) -> None:
-    if not folder.is_dir():
-        raise FileNotFoundError(f"{folder}: no such folder; it should hold the camera's {num_frames} frames")
-    present = set(os.listdir(folder))
-    for i in range(num_frames):
-        if frame_filename(i) not in present:
-            raise FileNotFoundError(
-                f"{folder / frame_filename(i)}: missing frame file (recording has {num_frames} frames)"
-            )
-
-
-def _read_png(file: Path, mode: str, shape: tuple[int, ...], what: str) -> np.ndarray:
+def _check_frame_files(folder: Path, num_frames: int, kind: str, camera: Camera) -> None:
+    """Check that ``folder`` holds frames 0 .. num_frames - 1 of ``kind`` ("depth" or
+    "color", `_IMAGES`), each a regular file whose PNG header has the kind's mode and the
+    camera's size (nothing decoded), and no frame file numbered num_frames or more."""
     try:
-        with Image.open(file) as image:
+        names = os.listdir(folder)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{folder}: no such folder; it should hold the camera's {num_frames} frames") from None
+    except OSError as problem:
+        raise RecordingError(
+            f"{folder}: cannot list it ({problem.strerror or problem}); it should hold the camera's {num_frames} frames"
+        ) from None
+    extra = sorted(n for n in names if _FRAME_NAME.fullmatch(n) and int(n[:-4]) >= num_frames)
+    if extra:
+        raise RecordingError(
+            f"{folder}: {len(extra)} frame file(s) past the recording's \"num_frames\" {num_frames} "
+            f"({extra[0]}{' .. ' + extra[-1] if len(extra) > 1 else ''}); set num_frames in "
+            f"{_JSON_NAME} to the frames there are, or remove the files after the last frame"
+        )
+    present = set(names)
+    for i in range(num_frames):
+        file = folder / frame_filename(i)
+        if file.name not in present:
+            raise FileNotFoundError(f"{file}: missing frame file (recording has {num_frames} frames)")
+        _read_png(file, kind, camera, decode=False)
+
+
+def _read_png(file: Path, kind: str, camera: Camera, *, decode: bool = True) -> np.ndarray | None:
+    """The image of ``file``, a PNG of ``kind`` (a key of `_IMAGES`) of ``camera``'s size.
+
+    Mode and size are checked from the PNG header before anything is decoded (an image
+    over twice PIL's decompression-bomb limit is refused without its size). Returns (H, W) uint16,
+    (H, W, 3) uint8 or (H, W) uint8 as the kind's mode says, or None when ``decode`` is
+    False (the header checked only).
+    """
+    mode, what = _IMAGES[kind]
+    height, width = camera.height, camera.width
+    expected = f"{what} PNG (mode {mode!r}) of {width}x{height}"
+    try:
+        check_regular_file(file, RecordingError, expected)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{file}: missing frame file") from None
+    try:
+        handle = open(file, "rb")
+    except OSError as problem:  # permission denied, a link loop
+        raise RecordingError(f"{file}: cannot read it ({problem.strerror or problem}); expected {expected}") from None
+    try:
+        with handle, warnings.catch_warnings():  # the size is checked below, before anything is decoded
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            image = Image.open(handle)
             if image.format != "PNG" or image.mode != mode:
                 raise RecordingError(
                     f"{file}: expected {what} PNG (mode {mode!r}), got a {image.format} image of mode {image.mode!r}"
                 )
-            array = np.asarray(image)
-    except FileNotFoundError:
-        raise FileNotFoundError(f"{file}: missing frame file") from None
-    except (UnidentifiedImageError, OSError, SyntaxError) as error:
+            if image.size != (width, height):
+                raise RecordingError(
+                    f"{file}: image is {image.size[0]}x{image.size[1]}, the camera is {width}x{height}"
+                )
+            return np.asarray(image) if decode else None
+    except RecordingError:
+        raise
+    except Image.DecompressionBombError as error:
+        raise RecordingError(f"{file}: far too large an image for a frame; expected {expected} ({error})") from None
+    except UnidentifiedImageError:
+        raise RecordingError(f"{file}: not a readable PNG image (cannot identify image file)") from None
+    except (OSError, SyntaxError, ValueError) as error:
         raise RecordingError(f"{file}: not a readable PNG image ({error})") from None
-    if array.shape != shape:
-        raise RecordingError(f"{file}: image is {array.shape[1]}x{array.shape[0]}, the camera is {shape[1]}x{shape[0]}")
-    return array
 
 
 class Recording:
     """An open recording folder (read-only; images are read on demand).
 
     Attributes: ``path`` (Path), ``fps`` (float), ``num_frames`` (int), ``cameras``
-    (list of Camera). Opening checks ``recording.json`` and that every frame file exists.
+    (list of Camera). Opening checks ``recording.json``, that every frame file exists and
+    that its PNG header gives the right mode and size (nothing is decoded), and that no
+    camera has frame files past ``num_frames``.
     """
 
     def __init__(self, path: str | os.PathLike):
@@ -320,9 +384,9 @@ class Recording:
         self._by_name = {c.name: c for c in self.cameras}
         self._color_names = []
         for camera in self.cameras:
-            _check_frame_files(self.path / camera.name / "depth", self.num_frames)
+            _check_frame_files(self.path / camera.name / "depth", self.num_frames, "depth", camera)
             if (self.path / camera.name / "color").exists():
-                _check_frame_files(self.path / camera.name / "color", self.num_frames)
+                _check_frame_files(self.path / camera.name / "color", self.num_frames, "color", camera)
                 self._color_names.append(camera.name)
 
     def __repr__(self) -> str:
@@ -354,7 +418,7 @@ class Recording:
         """(H, W) uint16 raw depth of camera ``name`` at frame ``index`` (metres = value * depth_scale)."""
         camera = self.camera(name)
         file = self.path / name / "depth" / frame_filename(self._check_index(index))
-        return _read_png(file, "I;16", (camera.height, camera.width), "a 16-bit grayscale depth")
+        return _read_png(file, "depth", camera)
 
     def color(self, index: int, name: str) -> np.ndarray:
         """(H, W, 3) uint8 RGB image of camera ``name`` at frame ``index``."""
@@ -362,7 +426,7 @@ class Recording:
         if name not in self._color_names:
             raise RecordingError(f"{self.path / name}: camera {name!r} has no color folder")
         file = self.path / name / "color" / frame_filename(self._check_index(index))
-        return _read_png(file, "RGB", (camera.height, camera.width, 3), "an 8-bit RGB colour")
+        return _read_png(file, "color", camera)
 
     def label(self, index: int, name: str, kind: str) -> np.ndarray:
         """(H, W) uint8 synthetic label image (``kind`` in LABEL_KINDS) of camera ``name``.
@@ -376,7 +440,7 @@ class Recording:
         file = self.path / name / kind / frame_filename(self._check_index(index))
         if not file.parent.is_dir():
             raise RecordingError(f"{file.parent}: this recording has no {kind!r} label images (only synthetic ones do)")
-        return _read_png(file, "L", (camera.height, camera.width), f"an 8-bit {kind} label")
+        return _read_png(file, kind, camera)
 
     def has_labels(self, kind: str) -> bool:
         """Whether every camera has ``kind`` label images (LABEL_KINDS; synthetic recordings)."""
@@ -384,19 +448,20 @@ class Recording:
             raise ValueError(f"unknown label kind {kind!r}; valid: {', '.join(LABEL_KINDS)}")
         return all((self.path / c.name / kind).is_dir() for c in self.cameras)
 
-    def frame(self, index: int) -> Frame:
-        """Frame ``index``: depth in float32 metres for every camera, colour where there is any."""
+    def frame(self, index: int, *, color: bool = True) -> Frame:
+        """Frame ``index``: depth in float32 metres for every camera, colour where there is
+        any (none read when ``color`` is False: ``Frame.color`` is then empty)."""
         index = self._check_index(index)
         depth = {
             c.name: (self.depth_raw(index, c.name) * c.depth_scale).astype(np.float32) for c in self.cameras
         }
-        color = {name: self.color(index, name) for name in self._color_names}
-        return Frame(index=index, depth=depth, color=color)
+        colors = {name: self.color(index, name) for name in self._color_names} if color else {}
+        return Frame(index=index, depth=depth, color=colors)
 
-    def frames(self) -> Iterator[Frame]:
-        """Iterate over all frames in order, reading each when it is reached."""
+    def frames(self, *, color: bool = True) -> Iterator[Frame]:
+        """Iterate over all frames in order, reading each when it is reached (`frame`)."""
         for index in range(self.num_frames):
-            yield self.frame(index)
+            yield self.frame(index, color=color)
 
     @property
     def has_groundtruth(self) -> bool:
@@ -410,7 +475,7 @@ class Recording:
         those with at least one row, in increasing id order.
         """
         file = self.path / _GROUNDTRUTH_NAME
-        if not file.is_file():
+        if not file.exists():
             raise FileNotFoundError(f"{file}: no such file; this recording has no ground truth")
         try:
             table = read_joint_table(file, self.num_frames, "groundtruth")
