@@ -20,11 +20,12 @@ from benchmarks import (  # noqa: E402
     bench_render,
     bench_robustness,
     bench_speed,
+    bench_stages,
     bench_tracking,
     format_table,
 )
 
-BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed,
+BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages,
               bench_robustness]
 
 

@@ -106,9 +106,12 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
         thread competes with the likelihood kernels' two threads (benchmarks/bench_speed.py)
     With ``grid.noise_model`` measured, each camera's noise is measured from the first
     ``grid.noise_frames`` frames first (:func:`occupose.grid.noise.measure_noise`).
-    An empty recording (no frames) gives an empty result. Only depth is read: the tracker
-    takes no colour (the colour images were checked when the recording was opened).
+    The frames are read and decoded on a thread of their own, a few ahead
+    (:class:`occupose.io.prefetch.Prefetch`). An empty recording (no frames) gives an empty
+    result. Only depth is read: the tracker takes no colour (the colour images were checked
+    when the recording was opened).
     """
+    from occupose.io.prefetch import Prefetch
     from occupose.io.recording import Recording
 
     if isinstance(recording, (str, os.PathLike)):
@@ -122,7 +125,8 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
         first = (frame.depth for frame in itertools.islice(recording.frames(color=False), config.grid.noise_frames))
         noise = measure_noise(recording.cameras, first, config.grid)
     tracker = Tracker(recording.cameras, recording.fps, config, seed=seed, noise=noise)
-    return track_frames(tracker, recording.frames(color=False), recording.num_frames, progress, overlap=overlap)
+    with Prefetch(recording.frames(color=False)) as frames:  # the next frames decoded while this one is tracked
+        return track_frames(tracker, frames, recording.num_frames, progress, overlap=overlap)
 
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:

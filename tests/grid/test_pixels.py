@@ -1,6 +1,8 @@
 """Stage 2: each tracked person's pixels and points (exclusion principle), on small rendered
 scenes and on the synthetic scenarios with the real occupancy grid."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -9,7 +11,7 @@ from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.pixels import (
     FALLBACKS, PersonPixels, _nearest_track, distance_to_points, pixels_from_depth,
-    predicted_from_tracks,
+    predicted_from_tracks, window_of_box,
 )
 from occupose.grid.occupancy import OccupancyGrid, spec_from_cameras
 from occupose.grid.spec import GridSpec
@@ -98,6 +100,38 @@ def test_pixels_go_to_the_track_of_their_cell():
         assert isinstance(obs, PersonPixels) and obs.track_id == tid
         np.testing.assert_array_equal(obs.pixels["cam"], np.flatnonzero(image.reshape(-1) == tid))
         np.testing.assert_allclose(obs.points, points[np.isin(pixels, obs.pixels["cam"])])
+
+
+def test_only_the_window_of_the_tracks_box_is_read():
+    """Each camera reads only the window its view of the tracks' box (one cell wider)
+    covers; the observations equal those of reading every pixel (the same blobs with a box
+    as large as the grid), for two cameras, with and without the grid's states."""
+    wall = box((0, 3.5, 1.1), (3.0, 0.05, 1.1), GREY)
+    bodies = concat([wall, box((-0.6, 2.0, 0.85), (0.15, 0.1, 0.85), GREY, person=1),
+                     box((0.3, 2.6, 0.85), (0.15, 0.1, 0.85), GREY, person=2)])
+    depths = {cam.name: render_camera(bodies, cam).depth for cam in (CAMERA, SIDE)}
+    mask = np.zeros(SPEC.shape, bool)
+    mask[26:30, 28:33, 2:34] = True  # the first box's cells and the wall's edge of them: E there
+    mask[45:49, 40:44, 2:34] = True
+    labels, blobs = blobs_from_mask(mask, SPEC)
+    tracks = BlobTracker(30.0).update(blobs)
+    whole = {t: replace(b, low=np.asarray(SPEC.origin), high=SPEC.high) for t, b in tracks.items()}
+    for cam in (CAMERA, SIDE):
+        v0, v1, u0, u1 = window_of_box(cam, *(np.asarray(SPEC.origin), SPEC.high))
+        assert (v0, v1, u0, u1) == (0, cam.height, 0, cam.width)  # the grid's box: every pixel
+    v0, v1, u0, u1 = window_of_box(CAMERA, blobs[0].low, blobs[0].high)
+    assert (v1 - v0) * (u1 - u0) < 0.3 * CAMERA.height * CAMERA.width
+    states = np.where(mask, 1, 2).astype(np.uint8)
+    for given in (None, states):
+        got, assigned = pixels_from_depth(depths, [CAMERA, SIDE], SPEC, labels, tracks, states=given)
+        expected, assigned_whole = pixels_from_depth(depths, [CAMERA, SIDE], SPEC, labels, whole, states=given)
+        for name in depths:
+            np.testing.assert_array_equal(assigned[name], assigned_whole[name])
+            assert (assigned[name] > 0).sum() > 300
+        for tid, obs in got.items():
+            for name in depths:
+                np.testing.assert_array_equal(obs.pixels[name], expected[tid].pixels[name])
+                np.testing.assert_array_equal(obs.camera_points[name], expected[tid].camera_points[name])
 
 
 def test_shared_blob_goes_to_the_nearest_predicted_body():

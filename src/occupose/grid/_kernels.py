@@ -39,29 +39,36 @@ VISIBLE = 1
 HIDDEN = 2
 #: The observation function's Gaussian tails stop at this many tail widths.
 TAIL_CUT = 3.0
+#: Classes of one camera's observation of a cell: no measurement, the three values the
+#: observation function takes exactly (p_free, p_occ, 0.5), and its tails.
+UNCOVERED, SEEN_THROUGH, ON_SURFACE, BEHIND, TAIL = 0, 1, 2, 3, 4
+#: Cameras whose observation classes fit a cell's ``quiet`` code (4 ** 7 < 2 ** 16).
+QUIET_CAMERAS = 7
 
 
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def observation(epsilon, half_extent, width, p_occ, p_free):
-    """The observation function f(epsilon) (see occupose.grid.occupancy.observation_function)."""
+    """The observation function f(epsilon) (see occupose.grid.occupancy.observation_function)
+    and its class: SEEN_THROUGH (f = p_free exactly), ON_SURFACE (p_occ), BEHIND (0.5) or
+    TAIL (a value in between, depending on epsilon)."""
     if epsilon > half_extent:
         excess = epsilon - half_extent
         if excess > TAIL_CUT * width:
-            return p_free
-        return p_free + (p_occ - p_free) * math.exp(-0.5 * (excess / width) ** 2)
+            return p_free, SEEN_THROUGH
+        return p_free + (p_occ - p_free) * math.exp(-0.5 * (excess / width) ** 2), TAIL
     if epsilon < -half_extent:
         excess = -epsilon - half_extent
         if excess > TAIL_CUT * width:
-            return 0.5
-        return 0.5 + (p_occ - 0.5) * math.exp(-0.5 * (excess / width) ** 2)
-    return p_occ
+            return 0.5, BEHIND
+        return 0.5 + (p_occ - 0.5) * math.exp(-0.5 * (excess / width) ** 2), TAIL
+    return p_occ, ON_SURFACE
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
 def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, offsets, depth,
                 sigma_lut, lut_step, half_extents, tail_width, p_occ, p_free, transition, held, hold,
-                flush, probabilities, states, visibility):
-    """One frame of the grid, in place.
+                flush, probabilities, states, visibility, quiet):
+    """One frame of the grid, in place; returns the number of cells whose HMM step ran.
 
     origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
     rotations (C, 3, 3), translations (C, 3), intrinsics (C, 4) float64; sizes (C, 2),
@@ -73,18 +80,35 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
         ``transition``); hold : (N,) bool or (0,) bool
     flush : float, posterior probabilities below it are set to 0 (no subnormal floats)
     probabilities : (N, 3) float32 in/out; states, visibility : (N,) uint8 out
+    quiet : (N,) uint16 in/out, 0 or ``1 + sum_c class_c 4^c`` over the cameras' observation
+        classes (UNCOVERED, SEEN_THROUGH, ON_SURFACE, BEHIND) of the cell's last step when
+        that step was unheld and left its float32 probabilities bit for bit as they were. The
+        step is a function of the probabilities, the classes and the hold alone, so an
+        unheld cell whose code matches this frame's classes would give the same result
+        again: it is skipped (nothing is written; states and visibility are those of the
+        last step). A class TAIL, a held cell or more than QUIET_CAMERAS cameras give code 0.
+        An unheld cell of code > 0 whose probabilities equal those of the last such cell
+        stepped in its x slice with the same code (cells never seen, which share their
+        history) takes that step's result without computing it.
     """
     num_cameras = rotations.shape[0]
     use_hold = hold.size > 0
+    use_quiet = num_cameras <= QUIET_CAMERAS
     t_oo, t_om, t_oe = transition[0, 0], transition[0, 1], transition[0, 2]
     t_mo, t_mm, t_me = transition[1, 0], transition[1, 1], transition[1, 2]
     t_eo, t_em, t_ee = transition[2, 0], transition[2, 1], transition[2, 2]
     h_mo, h_mm, h_me = held[1, 0], held[1, 1], held[1, 2]
     lut_last = sigma_lut.shape[1] - 1
     lut_scale = 1.0 / lut_step
+    stepped = 0
     for i in numba.prange(nx):
         x = origin[0] + cell * (i + 0.5)
         column = np.empty((num_cameras, 3))  # camera-frame centre of cell (i, j, k)
+        last_code = 0  # the last unheld step of code > 0 in this slice: its input and output
+        last_in = np.zeros(3, np.float32)
+        last_out = np.zeros(3, np.float32)
+        last_state = 0
+        last_quiet = 0
         for j in range(ny):
             y = origin[1] + cell * (j + 0.5)
             z0 = origin[2] + 0.5 * cell
@@ -98,10 +122,14 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                 b_empty = 1.0
                 covered = False
                 seen = False
+                code = 1 if use_quiet else 0
+                power = 1
                 for c in range(num_cameras):
                     xc = column[c, 0] + k * cell * rotations[c, 0, 2]
                     yc = column[c, 1] + k * cell * rotations[c, 1, 2]
                     depth_l = column[c, 2] + k * cell * rotations[c, 2, 2]
+                    power_c = power
+                    power *= 4
                     if depth_l <= 0.0:
                         continue
                     inverse = 1.0 / depth_l
@@ -114,21 +142,37 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                         continue
                     covered = True
                     width = tail_width * sigma_lut[c, min(int(depth_l * lut_scale), lut_last)]
-                    epsilon = d - depth_l
-                    f = observation(epsilon, half_extents[c], width, p_occ, p_free)
-                    if epsilon >= -(half_extents[c] + TAIL_CUT * width):
+                    f, kind = observation(d - depth_l, half_extents[c], width, p_occ, p_free)
+                    if kind != BEHIND:
                         seen = True
+                    if kind == TAIL:
+                        code = 0
+                    elif code > 0:
+                        code += kind * power_c
                     b_occupied *= f
                     b_empty *= 1.0 - f
-                # forward step: Q_t ~ (Q_{t-1}^T A) o B_t
+                held_here = use_hold and hold[n]
+                if code > 0 and not held_here and quiet[n] == code:
+                    continue  # the step would change nothing
                 q_o = probabilities[n, 0]
                 q_m = probabilities[n, 1]
                 q_e = probabilities[n, 2]
+                if (code > 0 and not held_here and code == last_code and q_o == last_in[0] and q_m == last_in[1]
+                        and q_e == last_in[2]):  # the same step as the last one (cells never seen): its result
+                    probabilities[n, 0] = last_out[0]
+                    probabilities[n, 1] = last_out[1]
+                    probabilities[n, 2] = last_out[2]
+                    states[n] = last_state
+                    visibility[n] = VISIBLE if seen else (HIDDEN if covered else UNOBSERVED)
+                    quiet[n] = last_quiet
+                    continue
+                stepped += 1
+                # forward step: Q_t ~ (Q_{t-1}^T A) o B_t
                 o_o, o_e = t_oo, t_oe
                 if not seen and q_o >= q_m and q_o >= q_e:  # static and unseen: it stays
                     o_o, o_e = 1.0, 0.0
                 m_o, m_m, m_e = t_mo, t_mm, t_me  # the M row: the only one a hold changes
-                if use_hold and hold[n]:
+                if held_here:
                     m_o, m_m, m_e = h_mo, h_mm, h_me
                     if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
                         q_m += q_o
@@ -146,21 +190,26 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
                     r_m = 0.0
                 if r_e < flush:
                     r_e = 0.0
-                probabilities[n, 0] = r_o
-                probabilities[n, 1] = r_m
-                probabilities[n, 2] = r_e
+                s_o, s_m, s_e = np.float32(r_o), np.float32(r_m), np.float32(r_e)
+                unchanged = s_o == probabilities[n, 0] and s_m == probabilities[n, 1] and s_e == probabilities[n, 2]
+                quiet[n] = code if unchanged and not held_here else 0
+                probabilities[n, 0] = s_o
+                probabilities[n, 1] = s_m
+                probabilities[n, 2] = s_e
                 if r_o >= r_m and r_o >= r_e:
                     states[n] = 0
                 elif r_m >= r_e:
                     states[n] = 1
                 else:
                     states[n] = 2
-                if seen:
-                    visibility[n] = VISIBLE
-                elif covered:
-                    visibility[n] = HIDDEN
-                else:
-                    visibility[n] = UNOBSERVED
+                visibility[n] = VISIBLE if seen else (HIDDEN if covered else UNOBSERVED)
+                if code > 0 and not held_here:
+                    last_code = code
+                    last_in[0], last_in[1], last_in[2] = q_o, q_m, q_e
+                    last_out[0], last_out[1], last_out[2] = s_o, s_m, s_e
+                    last_state = states[n]
+                    last_quiet = quiet[n]
+    return stepped
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")

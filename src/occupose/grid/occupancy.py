@@ -406,7 +406,8 @@ class OccupancyGrid:
 
     After :meth:`update`: ``states`` (nx, ny, nz) uint8 MAP state (O, M, E),
     ``probabilities`` (nx, ny, nz, 3) float32 posterior over (O, M, E), ``visibility``
-    (nx, ny, nz) uint8 (VISIBLE, HIDDEN, UNOBSERVED), ``num_updates`` frames seen.
+    (nx, ny, nz) uint8 (VISIBLE, HIDDEN, UNOBSERVED), ``num_updates`` frames seen,
+    ``stepped`` the cells whose HMM step ran in the last update (the others would not change).
     """
 
     def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str | NoiseEstimate] | None = None, *,
@@ -449,7 +450,9 @@ class OccupancyGrid:
         self._probabilities[...] = initial
         self._states = np.full(spec.shape, int(np.argmax(initial)), np.uint8)
         self._visibility = np.zeros(spec.shape, np.uint8)
+        self._quiet = np.zeros(spec.num_cells, np.uint16)  # the kernel's skip codes (occupose.grid._kernels)
         self.num_updates = 0
+        self.stepped = 0
 
     def _camera_arrays(self) -> None:
         """Per-camera arrays of the kernel (module docstring of occupose.grid._kernels)."""
@@ -531,7 +534,13 @@ class OccupancyGrid:
             cell in its parallel loop.
 
         Runs one fused numba kernel over all cells (it releases the GIL, so another thread
-        can work meanwhile).
+        can work meanwhile). A cell's HMM step is skipped where it would change nothing: the
+        cell is not held, its last step left its probabilities bit for bit as they were, and
+        every camera observes it as then with the same value of the observation function
+        (seen through beyond the tails, on the surface, hidden beyond the tails, or not
+        measured). The step is a function of these alone, so the beliefs, states and
+        visibility are exactly those of stepping every cell; most of the background is such
+        cells once it has settled (``stepped``: the cells stepped in the last update).
         """
         self._check_depths(depths)
         if hold is None:
@@ -543,11 +552,12 @@ class OccupancyGrid:
                                  f"got {hold.dtype} {hold.shape}")
             hold = np.ascontiguousarray(hold).reshape(-1)
         nx, ny, nz = self.spec.shape
-        _kernels.update_grid(
+        self.stepped = _kernels.update_grid(
             np.asarray(self.spec.origin), self.spec.cell, nx, ny, nz, self._rotations, self._translations,
             self._intrinsics, self._sizes, self._offsets, self._depth, self._sigma_lut, _LUT_STEP,
             self._half_extents, self.tail_width, self.p_occ, self.p_free, self.transition, self.held_transition,
             hold, FLUSH, self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
+            self._quiet,
         )
         self.num_updates += 1
 
@@ -591,6 +601,7 @@ class OccupancyGrid:
                              f"got {cells.dtype} {cells.shape}")
         self._probabilities[cells] = (0.0, 1.0, 0.0)
         self._states[cells] = M
+        self._quiet[cells.reshape(-1)] = 0
 
     def visibility_at(self, points: np.ndarray) -> np.ndarray:
         """Visibility of the cells containing world points.

@@ -4,7 +4,9 @@ As in the first paper's Fig. 2(d), every measured depth pixel is back-projected 
 point, the point falls in a grid cell, the cell's label names a blob and the blob a track
 (the pixel-to-cell step is stage 1's `occupose.grid.occupancy.cells_from_depth`, which
 also gives a point on a silhouette edge, in a cell the grid holds empty, to its nearest
-occupied neighbour). Pixels whose cell is in no tracked blob belong to nobody.
+occupied neighbour). Pixels whose cell is in no tracked blob belong to nobody, so only the
+window of each image in which the tracks' cells (and their neighbours) are seen is read
+(`window_of_box`): the pass costs in proportion to the people's share of the image.
 
 Where tracks share a blob (merged people) the pixel goes to the nearest predicted body:
 the exclusion principle of the second paper (eq. 5, a(u) = argmin_t d(u, x_t)).
@@ -20,12 +22,12 @@ its centre (`FALLBACKS`).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from occupose.camera import Camera, points_from_depth
+from occupose.camera import Camera, pixels_from_points, points_from_depth
 from occupose.config import PixelsConfig
 from occupose.grid.blobs import Blob
 from occupose.grid.occupancy import E, M, cells_from_depth
@@ -124,6 +126,23 @@ def _label_codes(labels: np.ndarray, tracks: Mapping[int, Blob], ids: list[int])
     return codes
 
 
+def window_of_box(camera: Camera, low: np.ndarray, high: np.ndarray) -> tuple[int, int, int, int]:
+    """The image rows and columns ``(v0, v1, u0, u1)`` (half-open, at least one pixel) outside
+    of which no pixel's 3D point can lie in the box from ``low`` to ``high`` ((3,) world
+    metres): the box's corners projected (a box in front of the camera projects into the
+    convex hull of its corners' projections), with a pixel's margin for rounding; the whole
+    image when a corner is not in front of the camera."""
+    corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
+    uv, depth = pixels_from_points(corners, camera)
+    if not np.all(depth > 1e-6):
+        return 0, camera.height, 0, camera.width
+    u0 = int(np.clip(np.floor(uv[:, 0].min()) - 1, 0, camera.width - 1))
+    v0 = int(np.clip(np.floor(uv[:, 1].min()) - 1, 0, camera.height - 1))
+    u1 = int(np.clip(np.ceil(uv[:, 0].max()) + 2, u0 + 1, camera.width))
+    v1 = int(np.clip(np.ceil(uv[:, 1].max()) + 2, v0 + 1, camera.height))
+    return v0, v1, u0, u1
+
+
 def pixels_from_depth(
     depths: Mapping[str, np.ndarray],
     cameras: Sequence[Camera],
@@ -183,19 +202,31 @@ def pixels_from_depth(
         states = np.where(labels > 0, M, E).astype(np.uint8)
     codes = _label_codes(labels, tracks, ids)
     label_of_cell = np.append(labels.reshape(-1), 0)  # index -1 (no cell) reads the appended 0
+    # the tracks' cells and their neighbours (a point in an empty cell may join one): only
+    # the pixels in each camera's window of that box can be anyone's
+    low = np.min([b.low for b in tracks.values()], axis=0) - spec.cell
+    high = np.max([b.high for b in tracks.values()], axis=0) + spec.cell
     for camera in cameras:
         depth = np.asarray(depths[camera.name])
-        cell = cells_from_depth(depth, camera, spec, states).reshape(-1)
+        if depth.shape != (camera.height, camera.width):
+            raise ValueError(f"depth image for camera {camera.name!r} must have shape ({camera.height}, "
+                             f"{camera.width}), got {depth.shape}")
+        v0, v1, u0, u1 = window_of_box(camera, low, high)
+        window = depth[v0:v1, u0:u1]
+        cropped = replace(camera, width=u1 - u0, height=v1 - v0, cx=camera.cx - u0,
+                          cy=camera.cy - v0)  # the same rays: (u - u0) - (cx - u0) is u - cx exactly
+        cell = cells_from_depth(window, cropped, spec, states).reshape(-1)
         label = label_of_cell[cell]
         label[codes[label] == 0] = 0
-        points, pixels = points_from_depth(np.where(label.reshape(depth.shape) > 0, depth, 0), camera)
-        code = codes[label[pixels]]
+        points, local = points_from_depth(np.where(label.reshape(window.shape) > 0, window, 0), cropped)
+        pixels = (local // cropped.width + v0) * camera.width + local % cropped.width + u0
+        code = codes[label[local]]
         owner = np.zeros(pixels.size, np.int64)
         for k, tid in enumerate(ids):
             owner[code == (np.int64(1) << k)] = tid
         shared = np.flatnonzero((code & (code - 1)) != 0)
         if shared.size:
-            owner[shared] = _nearest_track(points[shared], cell[pixels[shared]], code[shared], ids, predicted,
+            owner[shared] = _nearest_track(points[shared], cell[local[shared]], code[shared], ids, predicted,
                                            lambda pts, tid: FALLBACKS[fallback](pts, centers[tid]), spec)
         assigned[camera.name].reshape(-1)[pixels] = owner
         for tid in ids:
