@@ -19,6 +19,30 @@ def positive_int(value: Any, what: str) -> int:
     return int(value)
 
 
+def seed_value(value: Any, what: str = "seed") -> int:
+    """``value`` as a seed: an int >= 0 (a bool or a float is not a seed). TypeError for
+    another type, ValueError for a negative int."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer >= 0, got {value!r} ({type(value).__name__})")
+    if value < 0:
+        raise ValueError(f"{what} must be an integer >= 0, got {value!r}")
+    return int(value)
+
+
+def flag(value: Any, what: str) -> bool:
+    """``value`` when it is a bool (TypeError otherwise: a string "false" is no false)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{what} must be True or False, got {value!r} ({type(value).__name__})")
+    return bool(value)
+
+
+def callback(value: Any, what: str) -> Any:
+    """``value`` when it is callable or None (TypeError otherwise)."""
+    if value is not None and not callable(value):
+        raise TypeError(f"{what} must be a function or None, got {value!r} ({type(value).__name__})")
+    return value
+
+
 def positive_float(value: Any, what: str) -> float:
     """``value`` as a finite float > 0."""
     number = _number(value, what)

@@ -312,6 +312,7 @@ def demo_cmd(out, scenario, frames, method) -> None:
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
+    config, name = build_config(None, method, {})  # before any rendering
     rec_path = _write_synth(scenario, out / scenario, seed=0, frames=frames, sensor=None, force=True,
                             procedural=True)
     rec = Recording(rec_path)
@@ -322,7 +323,6 @@ def demo_cmd(out, scenario, frames, method) -> None:
     hidden = 100.0 * (1 - gt.visible[np.isfinite(gt.joints[..., 0])].mean())
     click.echo(f"ground truth: {len(gt.person_ids)} person(s), {hidden:.1f} % of their joint observations hidden "
                "(furniture, other people, their own body, image border)")
-    config, name = build_config(None, method, {})
     try:
         tracks_path, result = run_tracking(rec, out / f"{scenario}-{method}", config, name, 0)
     except ValueError as error:

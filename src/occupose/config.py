@@ -150,7 +150,8 @@ class GridConfig(_Section):
     """Stage 1: the occupancy grid and its per-cell HMM (``occupose.grid.occupancy``)."""
 
     _path = "grid"
-    cell: float = setting(0.05, "edge of a grid cell", "m", low=0.02, high=0.5)
+    cell: float = setting(0.05, "edge of a grid cell (the grid's size is bounded by limits.grid_cells)", "m",
+                          low=0.001, high=0.5)
     height: float = setting(2.2, "top of the grid above the floor (the floor z = 0 is its bottom)", "m", above=0.0)
     max_range: float | None = setting(None, "how far along its optical axis each camera's view is kept; none: "
                                             "the camera's sensor preset's far range (for a camera that matches "
@@ -382,12 +383,13 @@ class PoseConfig(_Section):
     steep_down_deg: float = setting(60.0, "a camera looking down more steeply than this is a ceiling camera",
                                     "deg", low=0, high=90)
     filter: str = setting("apf+ps", "particle filter", choices=FILTER_NAMES)
-    particles: int = setting(200, "particles per person", "particles", low=1, high=100_000)
+    particles: int = setting(200, "particles per person (their cost is bounded by limits.evaluations)", "particles",
+                             low=1)
     layers: int | tuple[int, ...] | None = setting((2, 1, 2), "annealing layers: one number, or one per "
                                                               "partitioned-sampling stage (a model with another "
                                                               "number of stages gets the same total, spread from "
                                                               "the root down; none: the filter has no layers)",
-                                                   "layers", low=1, high=100)
+                                                   "layers", low=1)
     survival: float = setting(0.5, "annealing: the share of particles each layer's weights keep alive",
                               "share", above=0, high=1)
     resampling: str = setting("systematic", "resampling scheme", choices=RESAMPLING_NAMES)
@@ -406,6 +408,15 @@ class PoseConfig(_Section):
     proposal_share: float = setting(0.1, "share of the particles given to each limb proposal", "share", low=0,
                                     high=0.99)
 
+    def calls(self, stages: int) -> int:
+        """Likelihood calls of the filter per frame (each evaluates every particle) for a
+        body model of ``stages`` partitioned-sampling stages (3 full, 2 upper)."""
+        if self.filter == "apf":
+            return self.layers
+        if self.filter == "apf+ps":
+            return sum(self.layers) if isinstance(self.layers, tuple) else self.layers * stages
+        return stages if self.filter == "ps" else 1
+
     def _check(self) -> None:
         if self.filter in ("apf", "apf+ps") and self.layers is None:
             raise ConfigError(f"pose.layers must be set for the {self.filter!r} filter (it anneals)")
@@ -419,6 +430,14 @@ class PoseConfig(_Section):
         if self.filter == "apf" and isinstance(self.layers, tuple):
             raise ConfigError(f"pose.layers must be one number for the 'apf' filter (it has one stage), "
                               f"got {list(self.layers)}")
+
+
+#: Likelihood evaluations per person and frame of method ``ours`` (200 particles x 5 layers).
+_OURS_EVALUATIONS = PoseConfig().particles * PoseConfig().calls(3)
+
+
+def _layers_text(layers: int | tuple[int, ...] | None) -> str:
+    return "none" if layers is None else str(list(layers) if isinstance(layers, tuple) else layers)
 
 
 @dataclass(frozen=True)
@@ -555,6 +574,45 @@ class RecoverConfig(_Section):
 
 
 @dataclass(frozen=True)
+class LimitsConfig(_Section):
+    """Bounds on what a run may cost and on what its cameras may be, checked before any work
+    (``occupose.bounds``, ``occupose.grid.occupancy.spec_from_cameras``): a setting or a
+    camera beyond them is refused with the estimate, instead of a hang, a MemoryError or an
+    empty result. Each is far beyond every built-in scene, sensor preset and benchmark
+    (``docs/notes/2026-12-04-bounds.md`` has the figures); raise one to go past it."""
+
+    _path = "limits"
+    grid_cells: int = setting(20_000_000, "most cells of the occupancy grid (about 72 bytes each while it is made: "
+                                          "1.4 GB; the largest default grid of the scenes is 0.8 M cells, 12 M at "
+                                          "grid.cell 0.02)", "cells", low=1)
+    evaluations: int = setting(100_000, "most likelihood evaluations per person and frame, pose.particles times "
+                                        "the filter's layers or stages (ours: 1000, ps: 6000; about 0.7 s a "
+                                        "person and frame on one core at 1000 points)", "evaluations", low=1)
+    image_pixels: int = setting(4096 * 4096, "most pixels of a camera's image (the largest preset has 0.37 M)",
+                                "pixels", low=1)
+    min_fps: float = setting(1.0, "slowest frame rate tracked (the motion between two frames outgrows the "
+                                  "blob gate below it)", "frames/s", above=0)
+    max_fps: float = setting(1000.0, "fastest frame rate tracked (depth sensors give at most 300; windows counted "
+                                     "in frames grow with it)", "frames/s", above=0)
+    ray_angle_deg: float = setting(75.0, "every pixel's ray lies within this of the optical axis (the presets "
+                                         "reach 46; a principal point far outside the image or a tiny focal "
+                                         "length goes beyond)", "deg", above=0, high=89.9)
+    distance_m: float = setting(1000.0, "cameras are within this of the world origin (float32 positions lose "
+                                        "0.06 m at 1e6 m)", "m", above=0)
+    lowest_view_m: float = setting(0.5, "each camera's view within its far range comes down to at least this "
+                                        "height (one that does not looks up, or its pose is inverted: it sees "
+                                        "no floor and no legs; the scenes reach 0.05 m or lower)", "m", low=0)
+    floor_margin: float = setting(0.1, "a measured point this far below the floor is below it", "m", low=0)
+    below_floor_share: float = setting(0.5, "refused when, in a camera's first frame with measurements, a larger "
+                                            "share of its points within range is below the floor (a wrong pose "
+                                            "or depth_scale; the scenes have none)", "share", low=0, high=1)
+
+    def _check(self) -> None:
+        if self.min_fps > self.max_fps:
+            raise ConfigError(f"limits.min_fps must be <= limits.max_fps, got {self.min_fps} > {self.max_fps}")
+
+
+@dataclass(frozen=True)
 class TrackerConfig(_Section):
     """Every setting of a tracking run (see the module docstring); the default is ``ours``."""
 
@@ -572,6 +630,17 @@ class TrackerConfig(_Section):
     proposals: ProposalConfig = field(default_factory=ProposalConfig)
     occlusion: OcclusionConfig = field(default_factory=OcclusionConfig)
     recover: RecoverConfig = field(default_factory=RecoverConfig)
+    limits: LimitsConfig = field(default_factory=LimitsConfig)
+
+    def _check(self) -> None:
+        pose, stages = self.pose, 2 if self.pose.model == "upper" else 3  # auto: the full model's, the most
+        evaluations = pose.particles * pose.calls(stages)
+        if evaluations > self.limits.evaluations:
+            raise ConfigError(
+                f"pose.particles = {pose.particles} with the {pose.filter!r} filter's {pose.calls(stages)} "
+                f"likelihood calls a frame (pose.layers = {_layers_text(pose.layers)}) gives {evaluations:,} "
+                f"likelihood evaluations per person and frame, {evaluations / _OURS_EVALUATIONS:,.0f} times "
+                f"method ours'; the bound limits.evaluations is {self.limits.evaluations:,}")
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], *, source: str = "config") -> TrackerConfig:
@@ -587,10 +656,12 @@ class TrackerConfig(_Section):
         except ConfigError as error:
             raise ConfigError(f"{source}: {error}") from None
         values = {}
-        sections = {f.name for f in dataclasses.fields(cls)}
+        sections = cls._section_names()  # in their order: a message is the same from run to run
         for section, entries in data.items():
             if section not in sections:
-                raise ConfigError(f"{source}: unknown section {section!r}; valid: method, {', '.join(sections)}")
+                hint = " (the seed is no setting: give it with --seed, or seed= in Python)" if section == "seed" else ""
+                raise ConfigError(f"{source}: unknown section {section!r}; valid: method, {', '.join(sections)}"
+                                  f"{hint}")
             if not isinstance(entries, Mapping):
                 raise ConfigError(f"{source}: section {section!r} must be a table of settings, got "
                                   f"{_describe(entries)}")
@@ -675,3 +746,13 @@ def method_config(name: str) -> TrackerConfig:
     if not isinstance(name, str) or name not in METHODS:
         raise ConfigError(f"unknown method {name!r}; valid names: {', '.join(METHODS)}")
     return METHODS[name]
+
+
+def as_config(config: TrackerConfig | str) -> TrackerConfig:
+    """``config`` itself, or the config of the method it names; ConfigError naming the
+    argument for anything else (settings as a dict go through :meth:`TrackerConfig.from_dict`)."""
+    config = method_config(config) if isinstance(config, str) else config
+    if not isinstance(config, TrackerConfig):
+        raise ConfigError(f"config must be a TrackerConfig or a method name, got {type(config).__name__} "
+                          f"(settings as a dict: TrackerConfig.from_dict)")
+    return config

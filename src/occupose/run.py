@@ -18,7 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from occupose.config import TrackerConfig, method_config
+from occupose._validate import callback, flag, seed_value
+from occupose.bounds import check_cameras, check_fps
+from occupose.config import TrackerConfig, as_config
 from occupose.grid.noise import measure_noise
 from occupose.joints import NUM_JOINTS
 from occupose.tracker import STAGES, Tracker
@@ -58,6 +60,11 @@ def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: 
     them. ``progress`` : callable(n) called after each frame, or None. ``overlap`` : update
     the grid with the next frame while the pose stage works on the current one
     (:meth:`Tracker.update`'s ``upcoming``)."""
+    if not isinstance(tracker, Tracker):
+        raise TypeError(f"tracker must be an occupose.tracker.Tracker, got {type(tracker).__name__}")
+    if isinstance(num_frames, bool) or not isinstance(num_frames, (int, np.integer)) or num_frames < 0:
+        raise ValueError(f"num_frames must be an integer >= 0, got {num_frames!r}")
+    progress, overlap = callback(progress, "progress"), flag(overlap, "overlap")
     joints = {}
     visible = {}
     seconds = dict.fromkeys(STAGES, 0.0)
@@ -117,9 +124,12 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     if isinstance(recording, (str, os.PathLike)):
         recording = Recording(recording)
     if not isinstance(recording, Recording):
-        raise ValueError(f"recording must be a Recording or the path of a recording folder, got "
-                         f"{type(recording).__name__}")
-    config = method_config(config) if isinstance(config, str) else config
+        raise TypeError(f"recording must be a Recording or the path of a recording folder, got "
+                        f"{type(recording).__name__}")
+    config = as_config(config)
+    seed, progress, overlap = seed_value(seed), callback(progress, "progress"), flag(overlap, "overlap")
+    check_fps(recording.fps, config.limits)  # before the frames the noise is measured on are read
+    check_cameras(recording.cameras, config.limits)
     noise = None
     if config.grid.noise_model == "measured":
         first = (frame.depth for frame in itertools.islice(recording.frames(color=False), config.grid.noise_frames))

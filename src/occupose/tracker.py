@@ -36,9 +36,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from occupose._validate import seed_value
 from occupose.body import capsules_from_poses
+from occupose.bounds import check_cameras, check_first_view, check_fps, check_reach
 from occupose.camera import Camera
-from occupose.config import ConfigError, TrackerConfig, method_config
+from occupose.config import TrackerConfig, as_config
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.hold import cells_near_capsules
 from occupose.grid.noise import camera_noise
@@ -93,19 +95,21 @@ class Tracker:
 
     def __init__(self, cameras, fps: float, config: TrackerConfig | str = "ours", *, seed: int = 0,
                  noise: Mapping[str, NoiseEstimate] | None = None):
-        config = method_config(config) if isinstance(config, str) else config
-        if not isinstance(config, TrackerConfig):
-            raise ConfigError(f"config must be a TrackerConfig or a method name, got {type(config).__name__}")
+        config = as_config(config)
         cameras = [cameras] if isinstance(cameras, Camera) else list(cameras)
         self.cameras = cameras
-        self.fps = float(fps)
+        limits = config.limits
+        self.fps = check_fps(fps, limits)
+        check_cameras(cameras, limits)
         self.config = config
         pose = config.pose
         self.model_name = model_for(cameras, pose.steep_down_deg) if pose.model == "auto" else pose.model
         grid = config.grid
         self.noise = camera_noise(cameras, grid, noise)
         far = {name: c.max_range for name, c in self.noise.items()}
-        self.spec = spec_from_cameras(cameras, cell=grid.cell, height=grid.height, max_range=far)
+        check_reach(cameras, far, limits)
+        self.spec = spec_from_cameras(cameras, cell=grid.cell, height=grid.height, max_range=far,
+                                      max_cells=limits.grid_cells)
         self.grid = OccupancyGrid(self.spec, cameras, {name: c.model for name, c in self.noise.items()},
                                   alpha=grid.alpha, beta=grid.beta, gamma=grid.gamma, psi=grid.psi, p_occ=grid.p_occ,
                                   p_free=grid.p_free, tail_width=grid.tail_width, initial=grid.initial, max_range=far)
@@ -115,7 +119,8 @@ class Tracker:
                                  fragment_m=blobs.fragment_m, min_share=blobs.min_share,
                                  position_gain=blobs.position_gain, velocity_gain=blobs.velocity_gain)
         self.people: dict[int, Person] = {}
-        self.seed = seed
+        self.seed = seed_value(seed)
+        self._unviewed = {c.name for c in cameras}  # cameras whose first measured frame is not checked yet
         self._seeds = np.random.SeedSequence(seed)
         self._previous = {}
         self._pending: dict[int, list[np.ndarray]] = {}  # points of tracks not yet started
@@ -124,6 +129,12 @@ class Tracker:
         self.frame = -1
         self._pool: ThreadPoolExecutor | None = None  # the grid's thread when updates overlap
         self._grid_job = None
+
+    def _check_views(self, depths: Mapping[str, np.ndarray]) -> None:
+        """Each camera's first frame with measurements (:func:`occupose.bounds.check_first_view`)."""
+        for cam in [c for c in self.cameras if c.name in self._unviewed]:
+            if check_first_view(cam, np.asarray(depths[cam.name]), self.noise[cam.name].max_range, self.config.limits):
+                self._unviewed.discard(cam.name)
 
     def close(self) -> None:
         """Stop the grid's thread (when :meth:`update` was given ``upcoming`` frames)."""
@@ -153,6 +164,7 @@ class Tracker:
             self._grid_job = None
         else:
             self.grid.update(depths, hold=self._hold())
+        self._check_views(depths)
         if self.frame < self.config.start.still_frames:  # people still from the first frame are no background
             self.grid.seed_moving(still_people(self.grid.states, self.spec, depths, self.cameras, self.config.start,
                                                self.config.size, self.config.blobs.join_m) & ~self.grid.moving_mask())
