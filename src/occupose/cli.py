@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import threading
 from pathlib import Path
@@ -47,6 +48,24 @@ def _progress_bar(total: int, desc: str):
     return tqdm(total=total, desc=desc, unit="frame", dynamic_ncols=True, mininterval=1.0)
 
 
+@contextlib.contextmanager
+def _progress(desc: str):
+    """A progress callback ``report(n, total)``: its bar opens at the first call, once the
+    command has checked its input and outputs and knows the total; closed at the end."""
+    bars = []
+
+    def report(n: int, total: int) -> None:
+        if not bars:
+            bars.append(_progress_bar(total, desc))
+        bars[0].update(n)
+
+    try:
+        yield report
+    finally:
+        for bar in bars:
+            bar.close()
+
+
 @click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="occupose")
 def main() -> None:
@@ -70,23 +89,14 @@ def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: st
                  force: bool, procedural: bool = False) -> Path:
     from occupose.synth.catalogue import FramesOutOfRange, render_scenario
 
-    bars = []  # opened when the catalogue knows the number of frames, before the first is rendered
-
-    def progress(done: int, total: int) -> None:
-        if not bars:
-            bars.append(_progress_bar(total, f"rendering {name}"))
-        bars[0].update(done)
-
     try:
-        made = render_scenario(name, out, seed=seed, frames=frames, sensor=sensor, procedural=procedural,
-                               exists="replace" if force else "refuse", progress=progress)
+        with _progress(f"rendering {name}") as progress:
+            made = render_scenario(name, out, seed=seed, frames=frames, sensor=sensor, procedural=procedural,
+                                   exists="replace" if force else "refuse", progress=progress)
     except FramesOutOfRange as error:
         _fail(f"--frames must be in 1..{error.available} for {name}, got {frames}")
     except ValueError as error:
         _fail(str(error))
-    finally:
-        for bar in bars:
-            bar.close()
     scenario = made.scenario
     click.echo(f"wrote {out} ({made.num_frames} frames, {len(scenario.cameras)} camera(s), "
                f"{len(scenario.people)} person(s); motion: {scenario.motion_source})")
@@ -252,8 +262,9 @@ def run_tracking(rec, out: Path, config, method: str | None, seed: int, force: b
     first); returns (tracks path, result)."""
     from occupose.run import track_into
 
-    with _progress_bar(rec.num_frames, f"tracking ({method or 'custom'})") as bar:
-        return track_into(out, rec, config, method=method, seed=seed, force=force, progress=bar.update)
+    with _progress(f"tracking ({method or 'custom'})") as progress:
+        return track_into(out, rec, config, method=method, seed=seed, force=force,
+                          progress=lambda n: progress(n, rec.num_frames))
 
 
 def _layers(text: str | None):
@@ -391,24 +402,15 @@ def evaluate_cmd(scenarios, suite, methods, runs, frames, procedural, jobs, out,
     from occupose.evaluation.evaluate import evaluate, suite_scenarios
     from occupose.evaluation.report import table_i_markdown, table_rows
 
-    bars = []  # opened at the first report, once evaluate has checked its input and knows the total
-
-    def progress(n: int, total: int) -> None:
-        if not bars:
-            bars.append(_progress_bar(total, "evaluating"))
-        bars[0].update(n)
-
     if suite is not None and scenarios is not None:
         _fail("give --scenarios or --suite, not both")
     try:
         if suite is not None:
             scenarios = suite_scenarios(suite)
-        result = evaluate(scenarios, methods, runs, out=out, frames=frames, procedural=procedural,
-                          jobs=jobs, progress=progress, force=force)
+        with _progress("evaluating") as progress:
+            result = evaluate(scenarios, methods, runs, out=out, frames=frames, procedural=procedural,
+                              jobs=jobs, progress=progress, force=force)
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
-    finally:
-        for bar in bars:
-            bar.close()
     click.echo(table_i_markdown(table_rows(result.runs)))
     click.echo(f"report: {result.report}\nresults: {result.results}\nplots: {len(result.plots)} in {out}")

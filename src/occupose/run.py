@@ -159,7 +159,9 @@ def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method
             "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
 
 
-def _write_run_files(folder: Path, result: TrackingResult, recording_path, method: str | None) -> None:
+def _write_run_files(folder: Path, result: TrackingResult, recording_path: str | os.PathLike,
+                     method: str | None) -> None:
+    """A run's tracks.csv and summary.json, into the (staged) ``folder``."""
     from occupose.io.joint_table import write_tracks_csv
     from occupose.io.output import write_text
 

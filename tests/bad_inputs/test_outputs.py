@@ -212,12 +212,6 @@ class _Bar:
     def __init__(self, act):
         self.act = act
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
     def update(self, n):
         self.act(n)
 
@@ -248,6 +242,10 @@ INTERRUPTED = [
      lambda p: ["synth", "no_occlusion", p / "new", "--frames", FRAMES, "--procedural"]),
     ("138 Ctrl-C in synth --force over a recording", signal.SIGINT, 130,
      lambda p: ["synth", "no_occlusion", p / "rec", "--frames", FRAMES, "--procedural", "--seed", 4, "--force"]),
+    ("-- Ctrl-C in demo, fresh OUT", signal.SIGINT, 130, lambda p: ["demo", "--out", p / "new", "--frames", FRAMES]),
+    ("-- SIGTERM in evaluate, fresh OUT", signal.SIGTERM, 143,
+     lambda p: ["evaluate", "--scenarios", "no_occlusion", "--methods", "ours", "--runs", 1, "--frames", FRAMES,
+                "--procedural", "--jobs", 1, "--out", p / "new"]),
 ]
 
 
@@ -255,6 +253,7 @@ INTERRUPTED = [
 def test_an_interrupted_command_leaves_everything_as_it_was(place, monkeypatch, row, signum, status, arguments):
     args = arguments(place)
     before = _snapshot(place)
+    handler = signal.getsignal(signal.SIGTERM)
     monkeypatch.setattr(cli, "_progress_bar", _signal_at(2, signum))
     result = _invoke(args)
     assert result.exit_code == status, result.output
@@ -262,7 +261,7 @@ def test_an_interrupted_command_leaves_everything_as_it_was(place, monkeypatch, 
     assert result.output.strip().splitlines()[-1] == (f"Error: {what}; no output was left half-written, earlier "
                                                       "outputs are as they were")
     assert _snapshot(place) == before
-    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # the command's handler is gone again
+    assert signal.getsignal(signal.SIGTERM) == handler  # the command's handler is gone again
     if row.startswith("110"):  # nothing to clean by hand: the same command runs again, without --force
         monkeypatch.setattr(cli, "_progress_bar", lambda total, desc: _Bar(lambda n: None))
         assert _invoke(args).exit_code == 0 and Recording(place / "new").num_frames == FRAMES

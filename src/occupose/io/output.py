@@ -1,7 +1,9 @@
 """Writing outputs whole or not at all, and never over what occupose did not write.
 
-Every command and library function that writes goes through this module (DESIGN.md style
-rule 10). Two kinds of output:
+Every command that writes goes through this module, and so do the library functions that
+write a command's output (``run.write_run`` and ``run.track_into``,
+``synth.catalogue.render_scenario``, ``viz.show_frame``, ``evaluation.evaluate``); DESIGN.md
+style rule 10. Two kinds of output:
 
 - a *folder* (a recording, a run's ``tracks.csv`` and ``summary.json``, an evaluation):
   :func:`staged_folder` makes it in a hidden folder beside its destination and, once every
@@ -80,6 +82,13 @@ def _check_name(out: Path) -> None:
                               f"the file system takes at most {limit}")
 
 
+def _check_parents(out: Path) -> None:
+    """Refuse ``out`` below a file."""
+    for parent in out.parents:
+        if parent.exists() and not parent.is_dir():
+            raise OutputError(f"{out}: {parent} is a file, not a folder")
+
+
 def read_manifest(folder: str | os.PathLike) -> dict | None:
     """The :data:`MANIFEST` of ``folder`` as a dict (``kind``, ``files``), or None when there
     is none; an unreadable or malformed one is an :class:`OutputError`."""
@@ -110,9 +119,7 @@ def check_output(out: str | os.PathLike, kind: str, *, force: bool = False,
     if out.is_symlink() and not out.exists():
         raise OutputError(f"{out} is a broken symbolic link")
     if not out.exists():
-        for parent in out.parents:
-            if parent.exists() and not parent.is_dir():
-                raise OutputError(f"{out}: {parent} is a file, not a folder")
+        _check_parents(out)
         return None
     if not out.is_dir():
         raise OutputError(f"{out} exists and is not a folder")
@@ -169,7 +176,7 @@ def _usual_mode(path: Path, mode: int) -> None:
     os.chmod(path, mode & ~umask)
 
 
-def _os_error(error: OSError, out: Path, staging: Path | None = None) -> OSError:
+def _os_error(error: OSError, out: Path, staging: Path | None = None) -> Exception:
     """An OSError on output as an OutputError naming the destination's path (a path inside
     ``staging``, a temporary name, is named as it will be in ``out``); an OSError about a
     path elsewhere (an input) is returned as it is. One without a path (a failed write)
@@ -328,7 +335,7 @@ def is_occupose_picture(path: str | os.PathLike) -> bool:
     try:
         with Image.open(path) as image:
             return image.format == "PNG" and image.info.get("Software") == SOFTWARE
-    except Exception:  # noqa: BLE001 - anything unreadable is not a picture of ours
+    except Exception:  # anything unreadable is not a picture of ours
         return False
 
 
@@ -364,9 +371,7 @@ def staged_picture(out: str | os.PathLike, *, force: bool = False,
             raise OutputError(f"{out} exists (use --force to replace a picture occupose made)")
         if not is_occupose_picture(out):
             raise OutputError(f"{out} was not written by occupose: not replacing it, even with --force")
-    for parent in out.parents:
-        if parent.exists() and not parent.is_dir():
-            raise OutputError(f"{out}: {parent} is a file, not a folder")
+    _check_parents(out)
     made = []
     try:
         made += _make_parents(out.parent)
@@ -374,8 +379,9 @@ def staged_picture(out: str | os.PathLike, *, force: bool = False,
             yield temporary
     except OSError as error:
         _remove_made(made)
-        beside = error.filename and Path(error.filename).parent == out.parent  # the temporary name
-        raise _os_error(error if not beside else OSError(error.errno, error.strerror), out) from None
+        if error.filename and Path(error.filename).parent == out.parent:  # the temporary name: say out
+            error = OSError(error.errno, error.strerror)
+        raise _os_error(error, out) from None
     except BaseException:
         _remove_made(made)
         raise
