@@ -324,6 +324,8 @@ def test_a_scoring_error_after_tracking_is_a_clean_error(place):
     """Row 20: ground truth that breaks the recording's frame count, found when scoring."""
     header = (place / "rec" / "recording.json").read_text()
     (place / "rec" / "recording.json").write_text(header.replace(f'"num_frames": {FRAMES}', '"num_frames": 2'))
+    for image in (place / "rec" / "front").glob(f"*/{FRAMES - 1:06d}.png"):  # the last frame gone, its truth kept
+        image.unlink()
     result = _invoke(["track", place / "rec", "--out", place / "new"])
     assert result.exit_code == 1 and "groundtruth.csv" in result.output and "Error: " in result.output
     assert "Traceback" not in result.output and isinstance(result.exception, SystemExit)
