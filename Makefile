@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/occupose demo --out demo-output
+	$(BIN)/occupose demo --out demo-output --force
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

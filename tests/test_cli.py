@@ -97,7 +97,7 @@ def test_force_replaces_only_recordings_and_validates_first(tmp_path, recording)
     result = runner.invoke(main, ["synth", "dance", str(keep), "--force"])
     assert result.exit_code != 0 and "unknown scenario" in result.output
     result = runner.invoke(main, ["synth", "no_occlusion", str(keep), "--frames", "2", "--force"])
-    assert result.exit_code != 0 and "is not a recording folder" in result.output
+    assert result.exit_code != 0 and "was not written by occupose" in result.output
     assert (keep / "notes.txt").read_text() == "precious"
     afile = tmp_path / "a.txt"
     afile.write_text("x")

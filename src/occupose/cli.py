@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
 from pathlib import Path
 
 import click
@@ -12,13 +15,58 @@ def _fail(message: str) -> None:
     raise click.ClickException(message)
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread so that outputs under way are removed."""
+
+
+def _terminate(signum, frame) -> None:
+    raise _Terminated
+
+
+class _Commands(click.Group):
+    """The command group. Ctrl-C (SIGINT) and SIGTERM end a command with one line and exit
+    status 130 (143 for SIGTERM), after the output under way is removed: outputs are
+    written whole or not at all (occupose.io.output)."""
+
+    def invoke(self, ctx):
+        main_thread = threading.current_thread() is threading.main_thread()
+        previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as error:
+            what, status = ("terminated", 143) if isinstance(error, _Terminated) else ("interrupted", 130)
+            click.echo(f"Error: {what}; no output was left half-written, earlier outputs are as they were", err=True)
+            ctx.exit(status)
+        finally:
+            if main_thread:
+                signal.signal(signal.SIGTERM, previous)
+
+
 def _progress_bar(total: int, desc: str):
     from tqdm import tqdm
 
     return tqdm(total=total, desc=desc, unit="frame", dynamic_ncols=True, mininterval=1.0)
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@contextlib.contextmanager
+def _progress(desc: str):
+    """A progress callback ``report(n, total)``: its bar opens at the first call, once the
+    command has checked its input and outputs and knows the total; closed at the end."""
+    bars = []
+
+    def report(n: int, total: int) -> None:
+        if not bars:
+            bars.append(_progress_bar(total, desc))
+        bars[0].update(n)
+
+    try:
+        yield report
+    finally:
+        for bar in bars:
+            bar.close()
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="occupose")
 def main() -> None:
     """Track the 3D skeletons of people in depth-camera recordings."""
@@ -37,41 +85,26 @@ def scenarios_cmd() -> None:
         click.echo(f"{name:<{width}}  {entry.summary}")
 
 
-#: The CLI's words for what stands in the way of ``occupose synth``'s output (OutputInTheWay.reason).
-_IN_THE_WAY = {
-    "not a folder": "{out} exists and is not a folder",
-    "not empty": "{out} exists and is not empty (use --force to replace an earlier recording)",
-    "not a recording": "{out} is not a recording folder (no recording.json): not removing it, even with --force",
-}
-
-
 def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: str | None,
                  force: bool, procedural: bool = False) -> Path:
-    from occupose.synth.catalogue import FramesOutOfRange, OutputInTheWay, render_scenario
-
-    bars = []  # opened when the catalogue knows the number of frames, before the first is rendered
-
-    def progress(done: int, total: int) -> None:
-        if not bars:
-            bars.append(_progress_bar(total, f"rendering {name}"))
-        bars[0].update(done)
+    from occupose.synth.catalogue import FramesOutOfRange, render_scenario
 
     try:
-        made = render_scenario(name, out, seed=seed, frames=frames, sensor=sensor, procedural=procedural,
-                               exists="replace" if force else "refuse", progress=progress)
+        with _progress(f"rendering {name}") as progress:
+            made = render_scenario(name, out, seed=seed, frames=frames, sensor=sensor, procedural=procedural,
+                                   exists="replace" if force else "refuse", progress=progress)
     except FramesOutOfRange as error:
         _fail(f"--frames must be in 1..{error.available} for {name}, got {frames}")
-    except OutputInTheWay as error:
-        _fail(_IN_THE_WAY[error.reason].format(out=out))
     except ValueError as error:
         _fail(str(error))
-    finally:
-        for bar in bars:
-            bar.close()
     scenario = made.scenario
     click.echo(f"wrote {out} ({made.num_frames} frames, {len(scenario.cameras)} camera(s), "
                f"{len(scenario.people)} person(s); motion: {scenario.motion_source})")
     return out
+
+
+#: --force of every command that writes (the rule: README "Commands", occupose.io.output).
+_FORCE_HELP = "Replace an earlier output of occupose at the output path (only the files occupose wrote there)."
 
 
 @main.command("synth")
@@ -82,7 +115,7 @@ def _write_synth(name: str, out: Path, seed: int, frames: int | None, sensor: st
 @click.option("--frames", type=click.IntRange(min=1), default=None, help="Render only the first N frames.")
 @click.option("--sensor", default=None, help="Camera model for every camera (kinect_v1, kinect_v2, azure_nfov, realsense_d435).")
 @click.option("--procedural", is_flag=True, help="Use the built-in procedural motion even when real mocap clips are present.")
-@click.option("--force", is_flag=True, help="Replace OUT if it exists.")
+@click.option("--force", is_flag=True, help=_FORCE_HELP)
 def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
     """Render the synthetic scenario NAME into the recording folder OUT.
 
@@ -97,10 +130,12 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
 @main.command("show")
 @click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--frame", "index", type=click.IntRange(min=0), default=0, show_default=True)
-@click.option("--out", type=click.Path(path_type=Path), required=True, help="PNG file to write.")
+@click.option("--out", type=click.Path(path_type=Path), required=True,
+              help="PNG file to write (.png is appended to a name without a suffix).")
 @click.option("--tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="A tracks.csv to draw beside the ground truth.")
-def show_cmd(recording, index, out, tracks) -> None:
+@click.option("--force", is_flag=True, help=_FORCE_HELP)
+def show_cmd(recording, index, out, tracks, force) -> None:
     """Write a PNG of one frame: depth colour-mapped, skeletons drawn over it."""
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
@@ -108,7 +143,7 @@ def show_cmd(recording, index, out, tracks) -> None:
     try:
         rec = Recording(recording)
         track_data = _read_tracks(tracks, rec.num_frames, allow_unmarked=True) if tracks else None
-        path = show_frame(rec, index, out, track_data)
+        path = show_frame(rec, index, out, track_data, force=force)
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
     click.echo(f"wrote {path}")
@@ -222,13 +257,14 @@ def _layers_for(filter_name: str, layers):
     return None
 
 
-def run_tracking(rec, out: Path, config, method: str | None, seed: int) -> tuple[Path, object]:
-    """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json; returns (tracks path, result)."""
-    from occupose.run import track_recording, write_run
+def run_tracking(rec, out: Path, config, method: str | None, seed: int, force: bool) -> tuple[Path, object]:
+    """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json (``out`` checked
+    first); returns (tracks path, result)."""
+    from occupose.run import track_into
 
-    with _progress_bar(rec.num_frames, f"tracking ({method or 'custom'})") as bar:
-        result = track_recording(rec, config, seed=seed, progress=bar.update)
-    return write_run(out, result, rec.path, method), result
+    with _progress(f"tracking ({method or 'custom'})") as progress:
+        return track_into(out, rec, config, method=method, seed=seed, force=force,
+                          progress=lambda n: progress(n, rec.num_frames))
 
 
 def _layers(text: str | None):
@@ -257,8 +293,9 @@ def _layers(text: str | None):
               help="TOML or JSON file of settings (see docs/configuration.md); options given here win.")
 @click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
               help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable; none for none).")
+@click.option("--force", is_flag=True, help=_FORCE_HELP)
 def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config_file,
-              assignments) -> None:
+              assignments, force) -> None:
     """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json and prints
     the Table I row when the recording has ground truth."""
     from occupose.io.recording import Recording
@@ -270,15 +307,15 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
         rec = Recording(recording)
         if rec.num_frames == 0:
             _fail(f"{recording}: the recording has no frames, nothing to track")
-        tracks_path, result = run_tracking(rec, out, config, name, seed)
+        tracks_path, result = run_tracking(rec, out, config, name, seed, force)
+        click.echo(f"{len(result.tracks)} track(s) in {result.num_frames} frames at {result.fps:.1f} frames/s "
+                   f"-> {tracks_path}")
+        if not result.tracks:
+            click.echo("nobody was tracked (no moving person-sized blob in the recording)")
+        if rec.has_groundtruth:
+            click.echo(score_text(rec, tracks_path))
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
-    click.echo(f"{len(result.tracks)} track(s) in {result.num_frames} frames at {result.fps:.1f} frames/s "
-               f"-> {tracks_path}")
-    if not result.tracks:
-        click.echo("nobody was tracked (no moving person-sized blob in the recording)")
-    if rec.has_groundtruth:
-        click.echo(score_text(rec, tracks_path))
 
 
 @main.command("config")
@@ -305,15 +342,24 @@ def config_cmd(method, config_file, assignments) -> None:
 @click.option("--scenario", default="sit_behind_table", show_default=True)
 @click.option("--frames", type=click.IntRange(min=2), default=300, show_default=True)
 @click.option("--method", default="ours", show_default=True)
-def demo_cmd(out, scenario, frames, method) -> None:
+@click.option("--force", is_flag=True, help="Replace an earlier demo's outputs in OUT (only the files occupose wrote).")
+def demo_cmd(out, scenario, frames, method, force) -> None:
     """Render a built-in scenario with procedural motion (no shared data needed), track it,
-    print the Table I row and picture a frame with the skeletons."""
+    print the Table I row and picture a frame with the skeletons: OUT/SCENARIO (the
+    recording), OUT/SCENARIO-METHOD (the run) and OUT/SCENARIO_frameNNNN.png."""
     from occupose.io.joint_table import read_tracks_csv
+    from occupose.io.output import check_output
     from occupose.io.recording import Recording
     from occupose.viz import show_frame
 
     config, name = build_config(None, method, {})  # before any rendering
-    rec_path = _write_synth(scenario, out / scenario, seed=0, frames=frames, sensor=None, force=True,
+    run_out = out / f"{scenario}-{method}"
+    try:  # both folders, before any work
+        check_output(out / scenario, "recording", force=force)
+        check_output(run_out, "run", force=force)
+    except ValueError as error:
+        _fail(str(error))
+    rec_path = _write_synth(scenario, out / scenario, seed=0, frames=frames, sensor=None, force=force,
                             procedural=True)
     rec = Recording(rec_path)
     gt = rec.groundtruth()
@@ -324,17 +370,17 @@ def demo_cmd(out, scenario, frames, method) -> None:
     click.echo(f"ground truth: {len(gt.person_ids)} person(s), {hidden:.1f} % of their joint observations hidden "
                "(furniture, other people, their own body, image border)")
     try:
-        tracks_path, result = run_tracking(rec, out / f"{scenario}-{method}", config, name, 0)
-    except ValueError as error:
+        tracks_path, result = run_tracking(rec, run_out, config, name, 0, force)
+        click.echo(f"{len(result.tracks)} track(s) at {result.fps:.1f} frames/s (start-up excluded) -> {tracks_path}")
+        click.echo(score_text(rec, tracks_path))
+        tracks = read_tracks_csv(tracks_path, rec.num_frames)
+        present = np.flatnonzero(np.isfinite(gt.joints[..., 0, 0]).any(axis=1))
+        if present.size:
+            index = int(present[(2 * len(present)) // 3])
+            picture = show_frame(rec, index, out / f"{scenario}_frame{index:04d}.png", tracks, force=force)
+            click.echo(f"picture: {picture}")
+    except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
-    click.echo(f"{len(result.tracks)} track(s) at {result.fps:.1f} frames/s (start-up excluded) -> {tracks_path}")
-    click.echo(score_text(rec, tracks_path))
-    tracks = read_tracks_csv(tracks_path, rec.num_frames)
-    present = np.flatnonzero(np.isfinite(gt.joints[..., 0, 0]).any(axis=1))
-    if present.size:
-        index = int(present[(2 * len(present)) // 3])
-        picture = show_frame(rec, index, out / f"{scenario}_frame{index:04d}.png", tracks)
-        click.echo(f"picture: {picture}")
 
 
 @main.command("evaluate")
@@ -348,30 +394,23 @@ def demo_cmd(out, scenario, frames, method) -> None:
 @click.option("--procedural", is_flag=True, help="Use the built-in procedural motion even when real mocap clips are present.")
 @click.option("--jobs", type=click.IntRange(min=1), default=None, help="Worker processes (default: one per core; 1: no workers).")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
-              help="Folder for recordings/, runs/, results.csv, report.md and the plots (recordings are reused).")
-def evaluate_cmd(scenarios, suite, methods, runs, frames, procedural, jobs, out) -> None:
+              help="Folder for recordings/, runs/, results.csv, report.md and the plots.")
+@click.option("--force", is_flag=True, help="Replace an earlier evaluation in OUT (its recordings are reused where "
+              "the settings match; only the files occupose wrote are replaced).")
+def evaluate_cmd(scenarios, suite, methods, runs, frames, procedural, jobs, out, force) -> None:
     """Run methods x scenarios x runs and write OUT/report.md (Table I), OUT/results.csv and plots."""
     from occupose.evaluation.evaluate import evaluate, suite_scenarios
     from occupose.evaluation.report import table_i_markdown, table_rows
-
-    bars = []  # opened at the first report, once evaluate has checked its input and knows the total
-
-    def progress(n: int, total: int) -> None:
-        if not bars:
-            bars.append(_progress_bar(total, "evaluating"))
-        bars[0].update(n)
 
     if suite is not None and scenarios is not None:
         _fail("give --scenarios or --suite, not both")
     try:
         if suite is not None:
             scenarios = suite_scenarios(suite)
-        result = evaluate(scenarios, methods, runs, out=out, frames=frames, procedural=procedural,
-                          jobs=jobs, progress=progress)
+        with _progress("evaluating") as progress:
+            result = evaluate(scenarios, methods, runs, out=out, frames=frames, procedural=procedural,
+                              jobs=jobs, progress=progress, force=force)
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
-    finally:
-        for bar in bars:
-            bar.close()
     click.echo(table_i_markdown(table_rows(result.runs)))
     click.echo(f"report: {result.report}\nresults: {result.results}\nplots: {len(result.plots)} in {out}")

@@ -3,7 +3,9 @@
 :func:`track_recording` runs a :class:`occupose.tracker.Tracker` over a recording and
 returns a :class:`TrackingResult`; :func:`write_run` writes it as ``tracks.csv`` and
 ``summary.json`` (the resolved config included, so a run's output says everything that
-shaped it). :func:`track_frames` is the loop itself, for frames from anywhere.
+shaped it), and :func:`track_into` does both, the output checked before the tracking.
+:func:`track_frames` is the loop itself, for frames from anywhere. A run's folder is
+written whole or not at all, under the overwrite rule of :mod:`occupose.io.output`.
 """
 
 from __future__ import annotations
@@ -102,6 +104,18 @@ def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: 
                           {name: c.to_dict() for name, c in tracker.noise.items()})
 
 
+def _as_recording(recording):
+    """``recording`` (a Recording or the path of a recording folder) as a Recording."""
+    from occupose.io.recording import Recording
+
+    if isinstance(recording, (str, os.PathLike)):
+        recording = Recording(recording)
+    if not isinstance(recording, Recording):
+        raise TypeError(f"recording must be a Recording or the path of a recording folder, got "
+                        f"{type(recording).__name__}")
+    return recording
+
+
 def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: int = 0,
                     progress: Callable[[int], None] | None = None, overlap: bool = False) -> TrackingResult:
     """Track every person of a recording.
@@ -119,13 +133,8 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     when the recording was opened).
     """
     from occupose.io.prefetch import Prefetch
-    from occupose.io.recording import Recording
 
-    if isinstance(recording, (str, os.PathLike)):
-        recording = Recording(recording)
-    if not isinstance(recording, Recording):
-        raise TypeError(f"recording must be a Recording or the path of a recording folder, got "
-                        f"{type(recording).__name__}")
+    recording = _as_recording(recording)
     config = as_config(config)
     seed, progress, overlap = seed_value(seed), callback(progress, "progress"), flag(overlap, "overlap")
     check_fps(recording.fps, config.limits)  # before the frames the noise is measured on are read
@@ -150,15 +159,40 @@ def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method
             "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
 
 
-def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: str | os.PathLike,
-              method: str | None = None) -> Path:
-    """Write ``out``/tracks.csv and ``out``/summary.json (:func:`summary_of`); returns the
-    tracks.csv path. ``out`` is made if it does not exist."""
+def _write_run_files(folder: Path, result: TrackingResult, recording_path: str | os.PathLike,
+                     method: str | None) -> None:
+    """A run's tracks.csv and summary.json, into the (staged) ``folder``."""
     from occupose.io.joint_table import write_tracks_csv
+    from occupose.io.output import write_text
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    tracks_path = out / "tracks.csv"
-    write_tracks_csv(tracks_path, result.tracks)
-    (out / "summary.json").write_text(json.dumps(summary_of(result, recording_path, method), indent=2) + "\n")
-    return tracks_path
+    write_tracks_csv(folder / "tracks.csv", result.tracks)
+    write_text(folder / "summary.json", json.dumps(summary_of(result, recording_path, method), indent=2) + "\n")
+
+
+def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: str | os.PathLike,
+              method: str | None = None, *, force: bool = False) -> Path:
+    """Write ``out``/tracks.csv and ``out``/summary.json (:func:`summary_of`), whole or not
+    at all; returns the tracks.csv path. ``out`` must not exist or be empty, or with
+    ``force`` hold an earlier run (:func:`occupose.io.output.staged_folder`); it may not be
+    inside the recording. Raises :class:`occupose.io.output.OutputError` otherwise."""
+    from occupose.io.output import staged_folder
+
+    with staged_folder(out, "run", force=force, inputs=(recording_path,)) as folder:
+        _write_run_files(folder, result, recording_path, method)
+    return Path(out) / "tracks.csv"
+
+
+def track_into(out: str | os.PathLike, recording, config: TrackerConfig | str = "ours", *, method: str | None = None,
+               seed: int = 0, force: bool = False, progress: Callable[[int], None] | None = None
+               ) -> tuple[Path, TrackingResult]:
+    """:func:`track_recording`, then :func:`write_run` into ``out`` (``method`` names the
+    config in the summary), with ``out`` checked and its hidden folder made before the
+    tracking starts, so a run is not lost to an output that cannot be written. Returns
+    (the tracks.csv path, the result)."""
+    from occupose.io.output import staged_folder
+
+    recording = _as_recording(recording)
+    with staged_folder(out, "run", force=force, inputs=(recording.path,)) as folder:
+        result = track_recording(recording, config, seed=seed, progress=progress)
+        _write_run_files(folder, result, recording.path, method)
+    return Path(out) / "tracks.csv", result

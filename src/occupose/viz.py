@@ -8,6 +8,7 @@ import numpy as np
 
 from occupose.camera import pixels_from_points
 from occupose.joints import BONES
+from occupose.io.output import SOFTWARE, picture_path, staged_picture
 from occupose.io.recording import Recording
 
 
@@ -42,16 +43,30 @@ def draw_skeleton(ax, uv: np.ndarray, visible: np.ndarray, color: str, label: st
     ax.scatter(uv[ok & ~visible, 0], uv[ok & ~visible, 1], s=26, c=color, marker="x", linewidths=1.6, zorder=3)
 
 
-def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict | None = None) -> Path:
+def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict | None = None, *,
+               force: bool = False) -> Path:
     """Write a PNG of frame ``index``: for every camera, the depth image colour-mapped
     (black = no measurement) with the ground-truth skeletons over it (hidden joints as
     crosses, bones to them dashed; ``visible`` is the ground truth's flag, i.e. seen by
     *some* camera, so with several cameras a joint drawn visible may be hidden in this one) and, when given, tracked skeletons.
 
     tracks : optional {track id: (joints (T, 15, 3), visible (T, 15))} as read from a tracks.csv.
+    out : the PNG file (``.png`` is appended to a name without a suffix); an existing file
+        is replaced only with ``force`` and only if occupose wrote it, and never a file
+        inside the recording (:func:`occupose.io.output.staged_picture`).
+    Returns the path written.
     """
     if not 0 <= index < recording.num_frames:
         raise ValueError(f"frame {index} is out of range: {recording.path} has frames 0..{recording.num_frames - 1}")
+    out = picture_path(out)
+    with staged_picture(out, force=force, inputs=(recording.path,)) as temporary:
+        _draw_frame(recording, index, tracks).savefig(temporary, format="png", dpi=110, bbox_inches="tight",
+                                                      metadata={"Software": SOFTWARE})
+    return out
+
+
+def _draw_frame(recording: Recording, index: int, tracks: dict | None):
+    """The matplotlib Figure of :func:`show_frame`."""
     frame = recording.frame(index)
     gt = recording.groundtruth() if recording.has_groundtruth else None
     cams = recording.cameras
@@ -81,7 +96,4 @@ def show_frame(recording: Recording, index: int, out: str | Path, tracks: dict |
                 draw_skeleton(ax, uv, visible[index], "#00e5ff" if k == 0 else "#ff9800", label=f"track {track}")
         if ax.get_legend_handles_labels()[0]:
             ax.legend(loc="lower left", fontsize=6, framealpha=0.6)
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110, bbox_inches="tight")
-    return out
+    return fig

@@ -84,7 +84,7 @@ def test_evaluate_reuses_the_recording_and_runs_in_workers_as_in_process(evaluat
     in_process = (out / "runs" / "no_occlusion" / "ours" / "0" / "tracks.csv").read_text()
     seen = []
     result = evaluate("no_occlusion", "ours", 2, out=out, frames=FRAMES, procedural=True, jobs=2,
-                      progress=lambda n, total: seen.append((n, total)))
+                      progress=lambda n, total: seen.append((n, total)), force=True)
     assert recording.stat().st_mtime_ns == stamp  # same settings: not rendered again
     assert sum(n for n, _ in seen) == 3 * FRAMES and {t for _, t in seen} == {3 * FRAMES}
     assert [(r.scenario, r.method, r.seed) for r in result.runs] == [("no_occlusion", "ours", 0), ("no_occlusion", "ours", 1)]

@@ -2,12 +2,14 @@
 policies for a folder already there, the reusable render's record."""
 
 import json
+from pathlib import Path
 
 import pytest
 
 from occupose.io.recording import Recording
 from occupose.synth import catalogue
-from occupose.synth.catalogue import RENDER_INFO, FramesOutOfRange, OutputInTheWay, render_scenario
+from occupose.io.output import MANIFEST, OutputError
+from occupose.synth.catalogue import RENDER_INFO, FramesOutOfRange, render_scenario
 
 FRAMES = 3
 
@@ -46,6 +48,8 @@ def test_every_policy_writes_the_same_recording(tmp_path):
     a, b = _files(refused), _files(reused)
     assert RENDER_INFO not in {p.name for p in a}  # only "reuse" records itself
     del b[next(p for p in b if p.name == RENDER_INFO)]
+    manifest_a, manifest_b = json.loads(a.pop(Path(MANIFEST))), json.loads(b.pop(Path(MANIFEST)))
+    assert manifest_b["files"] == sorted([*manifest_a["files"], RENDER_INFO])  # every file it wrote
     assert a == b
 
 
@@ -53,21 +57,19 @@ def test_what_is_in_the_way_is_refused_and_kept(tmp_path):
     keep = tmp_path / "keep"
     keep.mkdir()
     (keep / "notes.txt").write_text("precious")
-    with pytest.raises(OutputInTheWay, match="is not a recording folder") as error:
+    with pytest.raises(OutputError, match=f"was not written by occupose \\(no {MANIFEST}\\)"):
         render_scenario("no_occlusion", keep, frames=2, procedural=True, exists="replace")
-    assert error.value.reason == "not a recording"
-    with pytest.raises(OutputInTheWay, match="exists and is not empty") as error:
+    with pytest.raises(OutputError, match="exists and is not empty"):
         render_scenario("no_occlusion", keep, frames=2, procedural=True)
-    assert error.value.reason == "not empty"
     assert (keep / "notes.txt").read_text() == "precious" and len(list(keep.iterdir())) == 1
     afile = tmp_path / "a.txt"
     afile.write_text("x")
-    with pytest.raises(OutputInTheWay, match="exists and is not a folder"):
+    with pytest.raises(OutputError, match="exists and is not a folder"):
         render_scenario("no_occlusion", afile, frames=2, procedural=True, exists="replace")
     # an earlier recording is replaced with "replace" only
     old = tmp_path / "old"
     render_scenario("no_occlusion", old, frames=2, procedural=True)
-    with pytest.raises(OutputInTheWay, match="exists and is not empty"):
+    with pytest.raises(OutputError, match="exists and is not empty"):
         render_scenario("no_occlusion", old, frames=3, procedural=True)
     assert render_scenario("no_occlusion", old, frames=3, procedural=True, exists="replace").num_frames == 3
     assert Recording(old).num_frames == 3
@@ -93,4 +95,5 @@ def test_input_is_checked_before_the_folder_is_touched(tmp_path, monkeypatch):
         (scenario.name, out, seed, num_frames)))
     clipped = render_scenario("top_view_two_people", tmp_path / "clip", frames=9999, procedural=True, clip_frames=True)
     assert clipped.num_frames == clipped.scenario.num_frames == 300
-    assert written == [("top_view_two_people", tmp_path / "clip", 0, 300)]
+    assert [(name, seed, frames) for name, _, seed, frames in written] == [("top_view_two_people", 0, 300)]
+    assert (tmp_path / "clip").is_dir()  # where the folder it wrote in was moved

@@ -1,8 +1,9 @@
 """Methods x scenarios x runs: the paper's Table I on our scenes, with plots.
 
-:func:`evaluate` renders every scenario once (``OUT/recordings/<scenario>``, reused when
-an earlier evaluation rendered it with the same settings), tracks each with every method
-and seed (``OUT/runs/<scenario>/<method>/<seed>/tracks.csv`` and ``summary.json``),
+:func:`evaluate` renders every scenario once (``OUT/recordings/<scenario>``; with
+``force``, an earlier evaluation's render with the same settings is reused), tracks each
+with every method and seed (``OUT/runs/<scenario>/<method>/<seed>/tracks.csv`` and
+``summary.json``),
 scores the runs against the ground truth and writes
 
 - ``OUT/results.csv``: one row per scenario, method, run and ground-truth person;
@@ -44,6 +45,7 @@ from occupose.evaluation.errors import frame_errors
 from occupose.evaluation.matching import match_tracks, person_errors, score
 from occupose.evaluation.pixels import ARM_PARTS, arm_epsilons
 from occupose.evaluation.report import RunResult, report_markdown, write_plots, write_results_csv
+from occupose.io.output import link_tree, staged_folder
 
 #: Methods compared when none are named.
 DEFAULT_METHODS: tuple[str, ...] = ("ours", "apf", "ps")
@@ -186,11 +188,12 @@ def _tracked_frame_errors(gt_joints: np.ndarray, gt_visible: np.ndarray, tracks:
 
 
 def run_method(recording: Path, scenario: str, method: str, seed: int, out: Path,
-               progress: Callable[[int], None] | None = None, overrides: Mapping[str, Any] | None = None
-               ) -> RunResult:
+               progress: Callable[[int], None] | None = None, overrides: Mapping[str, Any] | None = None,
+               recording_as: Path | None = None) -> RunResult:
     """Track ``recording`` with ``method`` (its config with ``overrides``, dotted keys) and
     ``seed`` into ``out``/tracks.csv and ``out``/summary.json, and score it against the
-    recording's ground truth."""
+    recording's ground truth. recording_as : the recording's path for summary.json, when
+    it is read from elsewhere until the evaluation is complete (None: ``recording``)."""
     from occupose.config import method_config
     from occupose.io.recording import Recording
     from occupose.run import track_recording, write_run
@@ -198,7 +201,7 @@ def run_method(recording: Path, scenario: str, method: str, seed: int, out: Path
     rec = Recording(recording)
     config = method_config(method).with_values(overrides or {})
     result = track_recording(rec, config, seed=seed, progress=progress)
-    write_run(out, result, rec.path, method)
+    write_run(out, result, rec.path if recording_as is None else recording_as, method)
     gt = rec.groundtruth()
     joints = {tid: track[0] for tid, track in result.tracks.items()}
     arms = None
@@ -236,7 +239,7 @@ def _in_worker(task: Callable, *args, **kwargs):
 def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str] | str | None = None,
              runs: int = 3, *, out: str | os.PathLike, frames: int | None = None, procedural: bool = False,
              jobs: int | None = None, progress: Progress | None = None,
-             overrides: Mapping[str, Any] | None = None) -> Evaluation:
+             overrides: Mapping[str, Any] | None = None, force: bool = False) -> Evaluation:
     """Run every method on every scenario ``runs`` times (seeds 0..runs-1) and report.
 
     scenarios : names of occupose.synth.scenarios.SCENARIOS or random scenes ``random-<seed>``
@@ -251,8 +254,13 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
     progress : callable(n, total) after n more frames were rendered or tracked, total
         being all the frames to render and track
     overrides : config values for every method, dotted keys (``{"pose.particles": 300}``)
+    force : replace an earlier evaluation of occupose in ``out`` (its renders are reused
+        where the settings match); without it ``out`` must not exist or be empty. The
+        evaluation is made beside ``out`` and swapped in whole
+        (:func:`occupose.io.output.staged_folder`).
 
-    Returns an Evaluation. Raises ValueError for unknown names or bad counts.
+    Returns an Evaluation. Raises ValueError for unknown names or bad counts, and
+    :class:`occupose.io.output.OutputError` (a ValueError) for an ``out`` it may not write.
     """
     from occupose.synth.random_scenes import PREFIX, is_random_name
     from occupose.synth.scenarios import SCENARIOS, build_scenario
@@ -265,11 +273,29 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
     frames = None if frames is None else positive_int(frames, "frames")
     jobs = len(os.sched_getaffinity(0)) if jobs is None else positive_int(jobs, "jobs")
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     lengths = {}
     for name in scenarios:
         length = build_scenario(name, seed=SCENE_SEED, use_mocap=not procedural).num_frames
         lengths[name] = length if frames is None else min(frames, length)
+    with staged_folder(out, "evaluation", force=force) as folder:
+        for name in scenarios:  # an earlier evaluation's renders, reused if rendered alike (render_recording)
+            if (out / "recordings" / name / "recording.json").is_file():
+                link_tree(out / "recordings" / name, folder / "recordings" / name)
+        results, plots, jobs = _run_all(folder, scenarios, methods, runs, lengths, frames, procedural, jobs,
+                                        progress, overrides, final=out)
+        results_path = write_results_csv(folder / "results.csv", results)
+        report_path = folder / "report.md"
+        report_path.write_text(report_markdown(results, plots, folder, jobs=jobs, frames=lengths,
+                                               procedural=procedural))
+    return Evaluation(results, out / report_path.name, out / results_path.name,
+                      [out / plot.relative_to(folder) for plot in plots])
+
+
+def _run_all(out: Path, scenarios: list[str], methods: list[str], runs: int, lengths: dict[str, int],
+             frames: int | None, procedural: bool, jobs: int, progress: Progress | None, overrides,
+             final: Path) -> tuple[list[RunResult], list[Path], int]:
+    """Render, run and plot everything of :func:`evaluate` in the folder ``out`` (to be
+    moved to ``final``); returns (the runs in order, the plots, the jobs used)."""
     total = sum(lengths[s] * (1 + runs * len(methods)) for s in scenarios)
     report = (lambda n: progress(n, total)) if progress is not None else None
     renders = {s: (render_recording, s, out / "recordings" / s, frames, procedural) for s in scenarios}
@@ -284,23 +310,21 @@ def evaluate(scenarios: Sequence[str] | str | None = None, methods: Sequence[str
         for scenario, task in renders.items():
             task[0](*task[1:], progress=report)
             for run in runs_of(scenario):
-                results.append(run[0](*run[1:], progress=report, overrides=overrides))
+                results.append(run[0](*run[1:], progress=report, overrides=overrides,
+                                      recording_as=final / "recordings" / scenario))
     else:
-        results = _in_pool(renders, runs_of, jobs, report, overrides)
+        results = _in_pool(renders, runs_of, jobs, report, overrides, final)
     order = {(s, m): i for i, (s, m) in enumerate((s, m) for s in scenarios for m in methods)}
     results.sort(key=lambda r: (order[r.scenario, r.method], r.seed))
     recordings = {s: out / "recordings" / s for s in scenarios}
     plots = write_plots(results, out, recordings, {s: _render_events(folder) for s, folder in recordings.items()})
-    results_path = out / "results.csv"
-    write_results_csv(results_path, results)
-    report_path = out / "report.md"
-    report_path.write_text(report_markdown(results, plots, out, jobs=jobs, frames=lengths, procedural=procedural))
-    return Evaluation(results, report_path, results_path, plots)
+    return results, plots, jobs
 
 
-def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, overrides) -> list[RunResult]:
+def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, overrides, final: Path) -> list[RunResult]:
     """Renders, then each scenario's runs as soon as its recording is there, on ``jobs``
-    spawned workers with one numba thread each."""
+    spawned workers with one numba thread each (``final``: the evaluation's folder when
+    complete, for the runs' summaries)."""
     context = multiprocessing.get_context("spawn")
     frames_done = context.Queue()
     results = []
@@ -319,7 +343,8 @@ def _in_pool(renders: dict, runs_of: Callable, jobs: int, progress, overrides) -
                         results.append(result)
                         continue
                     for run in runs_of(scenario):
-                        pending[pool.submit(_in_worker, *run, overrides=overrides)] = None
+                        pending[pool.submit(_in_worker, *run, overrides=overrides,
+                                            recording_as=final / "recordings" / scenario)] = None
         except BaseException:
             pool.shutdown(wait=False, cancel_futures=True)
             raise

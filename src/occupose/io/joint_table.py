@@ -43,6 +43,7 @@ import numpy as np
 
 from occupose._validate import bool_array, float_array
 from occupose.io._files import read_file_bytes
+from occupose.io.output import atomic_path
 from occupose.joints import JOINT_INDEX, JOINTS, NUM_JOINTS
 
 #: A joint table in memory: {id: (joints (T, 15, 3) float64 metres, visible (T, 15) bool)}.
@@ -163,10 +164,8 @@ def write_joint_table(path: str | os.PathLike, table: Mapping[int, tuple[Any, An
     if spec.end_line:
         lines.append(END_LINE.format(rows=len(lines) - 1) + "\n")
     path = Path(path)
-    temporary = path.with_name(path.name + ".tmp")
-    with temporary.open("w", newline="", encoding="utf-8") as handle:
+    with atomic_path(path) as temporary, temporary.open("w", newline="", encoding="utf-8") as handle:
         handle.writelines(lines)
-    os.replace(temporary, path)
     return path
 
 

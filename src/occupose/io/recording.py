@@ -37,6 +37,7 @@ from PIL import Image, UnidentifiedImageError
 from occupose.camera import Camera, camera_from_dict
 from occupose.io._files import check_regular_file, read_file_bytes
 from occupose.io.joint_table import JointTableError, read_joint_table, write_joint_table
+from occupose.io.output import write_text
 from occupose.joints import NUM_JOINTS
 
 FORMAT = "occupose-recording"
@@ -240,7 +241,7 @@ class RecordingWriter:
         # one camera per line, as in DESIGN.md, rather than one number per line
         head = json.dumps({"format": FORMAT, "version": VERSION, "fps": self.fps, "num_frames": self.num_frames})
         cameras = ",\n  ".join(json.dumps(c.to_dict()) for c in self.cameras)
-        (self.path / _JSON_NAME).write_text(f'{head[:-1]},\n "cameras": [\n  {cameras}\n ]}}\n')
+        write_text(self.path / _JSON_NAME, f'{head[:-1]},\n "cameras": [\n  {cameras}\n ]}}\n')
         self._closed = True
 
 

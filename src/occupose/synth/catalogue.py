@@ -5,28 +5,32 @@ and writes its first frames as a recording folder with ground truth
 (:func:`occupose.synth.generate.write_scenario`). ``occupose synth`` and ``occupose demo``
 call it, and so does the evaluation for its renders under ``OUT/recordings/``.
 
-What happens to a folder already at ``out`` is the caller's choice, ``exists``:
+The recording is made whole or not at all, beside ``out`` and swapped in
+(:func:`occupose.io.output.staged_folder`). What happens to a folder already at ``out``
+is the caller's choice, ``exists``:
 
-- ``"refuse"``: ``out`` must not exist or be an empty folder, else :class:`OutputInTheWay`;
-- ``"replace"``: as ``"refuse"``, but an earlier recording (a folder with
-  ``recording.json``) is removed first; anything else is still refused;
+- ``"refuse"``: ``out`` must not exist or be an empty folder, else
+  :class:`occupose.io.output.OutputError`;
+- ``"replace"``: as ``"refuse"``, but an earlier recording of occupose is replaced (the
+  overwrite rule of :mod:`occupose.io.output`: only the files it wrote); anything else is
+  still refused;
 - ``"reuse"``: a folder rendered earlier with the same settings and the same ground-truth
-  motion (as its :data:`RENDER_INFO` file records) is kept as it is; whatever else is
-  there is removed and rendered again. :data:`RENDER_INFO` is written last, so a
-  half-written folder is never reused. Only this policy writes it.
+  motion (as its :data:`RENDER_INFO` file records) is kept as it is; an earlier recording
+  of occupose rendered otherwise is replaced as with ``"replace"``. Only this policy writes
+  :data:`RENDER_INFO`.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from occupose.io.output import staged_folder
 from occupose.synth import scenarios
 from occupose.synth.generate import write_scenario
 from occupose.synth.scenarios import Scenario
@@ -46,19 +50,6 @@ class FramesOutOfRange(ValueError):
     def __init__(self, name: str, frames: int, available: int):
         super().__init__(f"frames must be in 1..{available} for {name}, got {frames}")
         self.name, self.frames, self.available = name, frames, available
-
-
-class OutputInTheWay(FileExistsError):
-    """Something at ``path`` that a new recording may not replace. ``reason``:
-    ``"not a folder"``, ``"not empty"`` (policy ``"refuse"``) or ``"not a recording"``
-    (policy ``"replace"``: a folder without ``recording.json`` is never removed)."""
-
-    def __init__(self, path: Path, reason: str):
-        message = {"not a folder": "exists and is not a folder",
-                   "not empty": "exists and is not empty (exists='replace' replaces an earlier recording)",
-                   "not a recording": "is not a recording folder (no recording.json): not removing it"}[reason]
-        super().__init__(f"{path} {message}")
-        self.path, self.reason = path, reason
 
 
 @dataclass(frozen=True)
@@ -93,7 +84,8 @@ def render_scenario(name: str, out, *, seed: int = 0, frames: int | None = None,
         (``done = 1``), or once with ``done = total`` when an earlier render is reused
 
     Everything is checked before anything at ``out`` is touched: the name (ValueError
-    listing the valid ones), the sensor, the frames, then the folder (:class:`OutputInTheWay`).
+    listing the valid ones), the sensor, the frames, then the folder
+    (:class:`occupose.io.output.OutputError`).
     """
     if exists not in EXISTS:
         raise ValueError(f"exists must be one of {', '.join(EXISTS)}, got {exists!r}")
@@ -110,16 +102,13 @@ def render_scenario(name: str, out, *, seed: int = 0, frames: int | None = None,
                 progress(0, total)
                 progress(total, total)
             return RenderedScenario(out, scenario, total, reused=True)
-        if out.exists():
-            shutil.rmtree(out)
-    else:
-        _make_room(out, replace=exists == "replace")
-    if progress is not None:
-        progress(0, total)
-    write_scenario(scenario, out, seed=seed, num_frames=total,
-                   progress=None if progress is None else lambda done: progress(done, total))
-    if exists == "reuse":
-        (out / RENDER_INFO).write_text(json.dumps(info) + "\n")
+    with staged_folder(out, "recording", force=exists != "refuse") as folder:
+        if progress is not None:
+            progress(0, total)
+        write_scenario(scenario, folder, seed=seed, num_frames=total,
+                       progress=None if progress is None else lambda done: progress(done, total))
+        if exists == "reuse":
+            (folder / RENDER_INFO).write_text(json.dumps(info) + "\n")
     return RenderedScenario(out, scenario, total, reused=False)
 
 
@@ -145,20 +134,4 @@ def _rendered_as(out: Path, info: dict) -> bool:
         return False  # unreadable: render again
 
 
-def _make_room(out: Path, replace: bool) -> None:
-    """Make ``out`` ready for a new recording: it must not exist, be empty, or (with
-    ``replace``) be an earlier recording, which is removed. Anything else is refused."""
-    if not out.exists():
-        return
-    if not out.is_dir():
-        raise OutputInTheWay(out, "not a folder")
-    if not any(out.iterdir()):
-        return
-    if not replace:
-        raise OutputInTheWay(out, "not empty")
-    if not (out / "recording.json").is_file():
-        raise OutputInTheWay(out, "not a recording")
-    shutil.rmtree(out)
-
-
-__all__ = ["EXISTS", "RENDER_INFO", "FramesOutOfRange", "OutputInTheWay", "RenderedScenario", "render_scenario"]
+__all__ = ["EXISTS", "RENDER_INFO", "FramesOutOfRange", "RenderedScenario", "render_scenario"]
