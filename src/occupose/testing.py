@@ -10,12 +10,17 @@ stage against it (foreground from the grid, track -> person by pixel overlap).
 - :func:`foreground_from_grid`: the pixels whose 3D point lies in a moving grid cell;
 - :func:`persons_from_tracks`: the ground-truth person of each track id, by pixel overlap;
 - :func:`person_observations` and :data:`UPPER_BODY_PARTS`: one person's likelihood
-  observations taken from the renderer's labels (stage 3 without stages 1-2).
+  observations taken from the renderer's labels (stage 3 without stages 1-2);
+- :func:`folder_snapshot`: every entry under a folder, to tell that a command changed
+  nothing there.
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -151,3 +156,22 @@ def person_observations(scenario: Scenario, num_frames: int, *, person: int = 1,
             mask &= np.isin(rendered.part, parts)
         out.append(observation_from_views([View(camera, frame.depth[camera.name], mask)], max_points=max_points))
     return out
+
+
+def folder_snapshot(folder: str | os.PathLike) -> dict[str, str]:
+    """Every entry under ``folder``, hidden ones included, by its path relative to it (with
+    ``/``): a file's SHA-256, ``"folder"``, or a symbolic link's ``"-> target"`` (not
+    followed). Two snapshots are equal when nothing under the folder changed."""
+    folder = Path(folder)
+    entries = {}
+    for root, dirs, files in os.walk(folder):
+        for name in dirs + files:
+            path = Path(root) / name
+            key = path.relative_to(folder).as_posix()
+            if path.is_symlink():
+                entries[key] = "-> " + os.readlink(path)
+            elif path.is_dir():
+                entries[key] = "folder"
+            else:
+                entries[key] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return entries

@@ -11,7 +11,6 @@ callback; the full disk is a real OS limit on the file size (RLIMIT_FSIZE), as r
 neither mount a small file system nor make a folder read-only.
 """
 
-import hashlib
 import os
 import resource
 import shutil
@@ -29,29 +28,13 @@ from occupose.io.output import MANIFEST, OutputError, is_occupose_picture, read_
 from occupose.io.recording import Recording
 from occupose.run import TrackingResult, write_run
 from occupose.viz import show_frame
+from occupose.testing import folder_snapshot
 
 FRAMES = 3
 
 
 def _invoke(args):
     return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def _snapshot(folder: Path) -> dict[str, str]:
-    """Every entry under ``folder`` (hidden ones included): a file's SHA-256, "folder", or a
-    symbolic link's target."""
-    entries = {}
-    for root, dirs, files in os.walk(folder):
-        for name in dirs + files:
-            path = Path(root) / name
-            key = path.relative_to(folder).as_posix()
-            if path.is_symlink():
-                entries[key] = "link " + os.readlink(path)
-            elif path.is_dir():
-                entries[key] = "folder"
-            else:
-                entries[key] = hashlib.sha256(path.read_bytes()).hexdigest()
-    return entries
 
 
 @pytest.fixture(scope="module")
@@ -189,12 +172,12 @@ def test_refused_or_failed_outputs_change_nothing(place, row, arguments, status,
     args = arguments(place)
     if any(str(a).startswith(("/proc", "/sys")) for a in args) and not Path("/proc/self").is_dir():
         pytest.skip("needs Linux's /proc and /sys")
-    before = _snapshot(place)
+    before = folder_snapshot(place)
     result = _invoke(args)
     assert result.exit_code == status, result.output
     assert message in result.output and "Error: " in result.output
     assert "Traceback" not in result.output and isinstance(result.exception, SystemExit)
-    assert _snapshot(place) == before  # nothing there before changed, nothing half-written left
+    assert folder_snapshot(place) == before  # nothing there before changed, nothing half-written left
 
 
 def test_writability_is_checked_before_the_tracking(place, monkeypatch):
@@ -252,7 +235,7 @@ INTERRUPTED = [
 @pytest.mark.parametrize("row, signum, status, arguments", INTERRUPTED, ids=[case[0] for case in INTERRUPTED])
 def test_an_interrupted_command_leaves_everything_as_it_was(place, monkeypatch, row, signum, status, arguments):
     args = arguments(place)
-    before = _snapshot(place)
+    before = folder_snapshot(place)
     handler = signal.getsignal(signal.SIGTERM)
     monkeypatch.setattr(cli, "_progress_bar", _signal_at(2, signum))
     result = _invoke(args)
@@ -260,7 +243,7 @@ def test_an_interrupted_command_leaves_everything_as_it_was(place, monkeypatch, 
     what = "interrupted" if signum == signal.SIGINT else "terminated"
     assert result.output.strip().splitlines()[-1] == (f"Error: {what}; no output was left half-written, earlier "
                                                       "outputs are as they were")
-    assert _snapshot(place) == before
+    assert folder_snapshot(place) == before
     assert signal.getsignal(signal.SIGTERM) == handler  # the command's handler is gone again
     if row.startswith("110"):  # nothing to clean by hand: the same command runs again, without --force
         monkeypatch.setattr(cli, "_progress_bar", lambda total, desc: _Bar(lambda n: None))
@@ -272,11 +255,11 @@ def test_force_replaces_a_run_and_keeps_the_users_files(place):
     _with_notes(place / "run")
     (place / "run" / "mine").mkdir()
     _with_notes(place / "run" / "mine", "more.txt")
-    theirs = {k: v for k, v in _snapshot(place / "run").items() if k.startswith(("notes", "mine"))}
+    theirs = {k: v for k, v in folder_snapshot(place / "run").items() if k.startswith(("notes", "mine"))}
     old = read_manifest(place / "run")
     result = _invoke(["track", place / "rec", "--out", place / "run", "--force", "--seed", 3])
     assert result.exit_code == 0, result.output
-    after = _snapshot(place / "run")
+    after = folder_snapshot(place / "run")
     assert {k: v for k, v in after.items() if k.startswith(("notes", "mine"))} == theirs
     assert sorted(after) == sorted([*old["files"], MANIFEST, *theirs])
     assert read_manifest(place / "run")["files"] == ["summary.json", "tracks.csv"]  # not the user's
@@ -336,7 +319,7 @@ def test_a_full_disk_leaves_the_earlier_run_whole(place):
     the earlier run stays as it was and nothing half-written is left."""
     tracks = read_tracks_csv(place / "run" / "tracks.csv", FRAMES)
     result = TrackingResult(tracks, num_frames=FRAMES)
-    before = _snapshot(place)
+    before = folder_snapshot(place)
     soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
     previous = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails instead of killing
     resource.setrlimit(resource.RLIMIT_FSIZE, (2048, hard))
@@ -346,4 +329,4 @@ def test_a_full_disk_leaves_the_earlier_run_whole(place):
     finally:
         resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
         signal.signal(signal.SIGXFSZ, previous)
-    assert _snapshot(place) == before
+    assert folder_snapshot(place) == before

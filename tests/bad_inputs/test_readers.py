@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import binascii
 import ctypes
-import hashlib
 import json
 import os
 import pickle
@@ -30,6 +29,7 @@ from PIL import Image
 from occupose.cli import main
 from occupose.io.joint_table import write_tracks_csv
 from occupose.io.recording import Recording
+from occupose.testing import folder_snapshot
 
 DEPTH = Path("front/depth")
 COLOR = Path("front/color")
@@ -482,22 +482,6 @@ CASES = [
 # --------------------------------------------------------------------------- running them
 
 
-def _snapshot(root: Path) -> dict[str, str]:
-    """Every file, link and folder under ``root``: a link by its target, a file by its hash."""
-    seen = {}
-    for folder, names, files in os.walk(root):
-        for name in names + files:
-            path = Path(folder) / name
-            key = str(path.relative_to(root))
-            if path.is_symlink():
-                seen[key] = "-> " + os.readlink(path)
-            elif path.is_dir():
-                seen[key] = "folder"
-            else:
-                seen[key] = hashlib.sha256(path.read_bytes()).hexdigest()
-    return seen
-
-
 def _drop_dac() -> None:
     """Give up root's permission override in this process (capabilities DAC_OVERRIDE and
     DAC_READ_SEARCH), so that a file's mode is obeyed as for any user."""
@@ -547,7 +531,7 @@ def test_bad_input(case, base, tmp_path):
     shutil.copytree(base[0], rec, symlinks=True)
     shutil.copy(base[1], tracks)
     case.mutate(rec, tracks)
-    before = _snapshot(tmp_path)
+    before = folder_snapshot(tmp_path)
     command, *flags = case.command.split()
     args = {"track": ["track", str(rec), "--out", str(tmp_path / "out")],
             "score": ["score", str(rec), str(tracks), *flags],
@@ -564,5 +548,5 @@ def test_bad_input(case, base, tmp_path):
     assert case.message in output, output
     if case.check is not None:
         case.check(output)
-    after = _snapshot(tmp_path)
+    after = folder_snapshot(tmp_path)
     assert {key: after.get(key) for key in before} == before

@@ -8,7 +8,6 @@ One 3-frame recording is rendered for the module (``occupose synth no_occlusion`
 rows that change the camera edit copies of its ``recording.json``.
 """
 
-import hashlib
 import json
 import math
 import shutil
@@ -25,14 +24,9 @@ from occupose.config import ConfigError, TrackerConfig
 from occupose.io.recording import Recording
 from occupose.run import track_frames, track_recording
 from occupose.tracker import Tracker
+from occupose.testing import folder_snapshot
 
 FRAMES = 3
-
-
-def _snapshot(folder: Path) -> dict[str, str]:
-    """Every file under ``folder``: its relative path -> SHA-256."""
-    return {p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +91,7 @@ def _check_refused(result, message: str, status: int, out: Path, recording: Path
     assert message in result.output, result.output
     assert "Traceback" not in result.output
     assert not out.exists()
-    assert _snapshot(recording) == before
+    assert folder_snapshot(recording) == before
 
 
 # -------------------------------------------------------------- the recording's camera and frame rate
@@ -123,7 +117,7 @@ CAMERA_ROWS = [  # row, change of recording.json, distinctive part of the messag
 def test_a_camera_or_frame_rate_beyond_the_bounds_is_refused_before_tracking(recording, tmp_path, row, change,
                                                                               message):
     rec = _camera_changed(recording, tmp_path, change)
-    before = _snapshot(rec)
+    before = folder_snapshot(rec)
     result = CliRunner().invoke(main, ["track", str(rec), "--out", str(tmp_path / "out")])
     _check_refused(result, message, 1, tmp_path / "out", rec, before)
 
@@ -171,7 +165,7 @@ OPTION_ROWS = [  # row, options of `occupose track`, distinctive part of the mes
 
 @pytest.mark.parametrize("row, options, message, status", OPTION_ROWS, ids=[r[0] for r in OPTION_ROWS])
 def test_a_bad_option_is_refused_before_any_work(recording, tmp_path, row, options, message, status):
-    before = _snapshot(recording)
+    before = folder_snapshot(recording)
     result = CliRunner().invoke(main, ["track", str(recording), "--out", str(tmp_path / "out"), *options])
     _check_refused(result, message, status, tmp_path / "out", recording, before)
 
@@ -213,7 +207,7 @@ CONFIG_ROWS = [  # row, config file (TOML), distinctive part of the message
 def test_a_bad_config_file_is_refused_before_any_work(recording, tmp_path, row, toml, message):
     config = tmp_path / "settings.toml"
     config.write_text(toml)
-    before = _snapshot(recording)
+    before = folder_snapshot(recording)
     result = CliRunner().invoke(main, ["track", str(recording), "--out", str(tmp_path / "out"), "--config",
                                        str(config)])
     _check_refused(result, message, 1, tmp_path / "out", recording, before)
