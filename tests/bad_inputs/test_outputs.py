@@ -238,7 +238,12 @@ def test_an_interrupted_command_leaves_everything_as_it_was(place, monkeypatch, 
     before = folder_snapshot(place)
     handler = signal.getsignal(signal.SIGTERM)
     monkeypatch.setattr(cli, "_progress_bar", _signal_at(2, signum))
-    result = _invoke(args)
+    # a process started in the background by a shell ignores SIGINT; Ctrl-C is what is tested
+    interrupt = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        result = _invoke(args)
+    finally:
+        signal.signal(signal.SIGINT, interrupt)
     assert result.exit_code == status, result.output
     what = "interrupted" if signum == signal.SIGINT else "terminated"
     assert result.output.strip().splitlines()[-1] == (f"Error: {what}; no output was left half-written, earlier "
