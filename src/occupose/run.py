@@ -105,14 +105,15 @@ def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: 
 
 
 def _as_recording(recording):
-    """``recording`` (a Recording or the path of a recording folder) as a Recording."""
-    from occupose.io.recording import Recording
+    """``recording`` (a frame source, or the path of a recording of any format, opened with
+    :func:`occupose.io.sources.open_source`) as a frame source."""
+    from occupose.io.sources import FrameSource, open_source
 
     if isinstance(recording, (str, os.PathLike)):
-        recording = Recording(recording)
-    if not isinstance(recording, Recording):
-        raise TypeError(f"recording must be a Recording or the path of a recording folder, got "
-                        f"{type(recording).__name__}")
+        recording = open_source(recording)
+    if not isinstance(recording, FrameSource):
+        raise TypeError(f"recording must be a frame source (occupose.io.sources.FrameSource, e.g. a Recording) or "
+                        f"the path of a recording, got {type(recording).__name__}")
     return recording
 
 
@@ -120,7 +121,8 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
                     progress: Callable[[int], None] | None = None, overlap: bool = False) -> TrackingResult:
     """Track every person of a recording.
 
-    recording : an :class:`occupose.io.recording.Recording` or the path of a recording folder
+    recording : a frame source (:class:`occupose.io.sources.FrameSource`, e.g. a Recording) or the
+        path of a recording of any format (:func:`occupose.io.sources.open_source`)
     config : a TrackerConfig or a method name (:data:`occupose.config.METHODS`)
     seed : the run's seed; progress : callable(n) after each frame, or None
     overlap : as :func:`track_frames`; off by default: on an idle 2-core machine the grid's

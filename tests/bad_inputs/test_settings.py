@@ -235,7 +235,7 @@ def opened(recording):
 
 LIBRARY_ROWS = [  # row, call on the opened recording, exception, distinctive part of the message
     ("132 None", lambda rec: track_recording(None), TypeError,
-     "recording must be a Recording or the path of a recording folder, got NoneType"),
+     "recording must be a frame source (occupose.io.sources.FrameSource, e.g. a Recording) or the path of a recording, got NoneType"),
     ("132 a number", lambda rec: track_recording(5), TypeError, "got int"),
     ("133 seed text", lambda rec: track_recording(rec, seed="x"), TypeError, "seed must be an integer >= 0, got 'x'"),
     ("133 seed float", lambda rec: track_recording(rec, seed=1.5), TypeError, "got 1.5 (float)"),
