@@ -62,7 +62,10 @@ def nonnegative_float(value: Any, what: str) -> float:
 def _number(value: Any, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"{what} must be a number, got {value!r}")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an integer beyond the largest float: not finite
+        return math.inf
 
 
 def float_array(value: Any, what: str, shape: tuple[int | None, ...]) -> np.ndarray:

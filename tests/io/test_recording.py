@@ -168,8 +168,9 @@ def test_writer_rejects_bad_input(tmp_path, rng):
         (tmp_path / "full").mkdir()
         (tmp_path / "full" / "x").write_text("")
         RecordingWriter(tmp_path / "full", cameras, 30.0)
-    with pytest.raises(ValueError, match="fps must be a positive"):
-        RecordingWriter(tmp_path / "a", cameras, 0.0)
+    for fps in (0.0, 10**400, float("nan"), "30"):
+        with pytest.raises(ValueError, match="fps must be a "):
+            RecordingWriter(tmp_path / "a", cameras, fps)
     with pytest.raises(ValueError, match="camera names must be unique"):
         RecordingWriter(tmp_path / "b", [cameras[0], cameras[0]], 30.0)
     writer = RecordingWriter(tmp_path / "c", cameras, 30.0)

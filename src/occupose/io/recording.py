@@ -34,6 +34,7 @@ from typing import Iterator, Mapping, Sequence
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
+from occupose._validate import positive_float
 from occupose.camera import Camera, camera_from_dict
 from occupose.io._files import check_regular_file, read_file_bytes
 from occupose.io.joint_table import JointTableError, read_joint_table, write_joint_table
@@ -117,12 +118,11 @@ class RecordingWriter:
         names = [c.name for c in cameras]
         if len(set(names)) != len(names):
             raise ValueError(f"camera names must be unique, got {names}")
-        if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not math.isfinite(fps) or fps <= 0:
-            raise ValueError(f"fps must be a positive finite number, got {fps!r}")
+        fps = positive_float(fps, "fps")
         if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
             raise FileExistsError(f"{self.path}: recording folder must not exist or be empty")
         self.cameras = cameras
-        self.fps = float(fps)
+        self.fps = fps
         self.num_frames = 0
         self._color_names: frozenset[str] | None = None
         self._groundtruth_frames: int | None = None
