@@ -22,7 +22,6 @@ RecordingError (a ValueError) or FileNotFoundError whose message names the file.
 from __future__ import annotations
 
 import json
-import math
 import os
 import re
 import sys
