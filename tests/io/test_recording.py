@@ -70,6 +70,7 @@ def test_round_trip_depth_colour_and_header(tmp_path, rng):
     assert recording.color_cameras == ("cam0",)
     frames = list(recording.frames())
     assert [f.index for f in frames] == [0, 1, 2] and all(isinstance(f, Frame) for f in frames)
+    assert [f.time for f in frames] == [0.0, 1 / 30, 2 / 30]
     for frame, depth, color in zip(frames, depths, colors):
         for camera in cameras:
             raw = recording.depth_raw(frame.index, camera.name)

@@ -24,8 +24,8 @@ class NpyFolder(StreamSource):
         self.cameras = [Camera("cam0", width, height, 50.0, 50.0, (width - 1) / 2, (height - 1) / 2)]
 
     def _raw_frames(self, color):
-        for image in self._depth:
-            yield {"cam0": np.array(image)}, {}
+        for index, image in enumerate(self._depth):  # a device clock starting at 1000 s, frame 2 late
+            yield {"cam0": np.array(image)}, {}, 1000.0 + 0.1 * index + (0.003 if index == 2 else 0.0)
 
 
 @pytest.fixture
@@ -43,6 +43,7 @@ def test_stream_source_frames_in_metres_and_by_index(npy_source):
     assert frames[0].depth["cam0"].dtype == np.float32
     assert frames[0].depth["cam0"][0, 0] == np.float32(2.0) and frames[0].depth["cam0"][9, 0] == np.float32(1.5)
     assert not frames[3].depth["cam0"].any()
+    assert [f.time for f in frames] == pytest.approx([0.0, 0.1, 0.203, 0.3, 0.4])
     assert npy_source.frame(4).index == 4
     with pytest.raises(SourceError, match=r"frame index 5 out of range; the recording has frames 0..4"):
         npy_source.frame(5)

@@ -75,11 +75,14 @@ class Frame:
     index : int, frame number from 0
     depth : dict camera name -> (H, W) float32, metres; 0 where there is no measurement
     color : dict camera name -> (H, W, 3) uint8 RGB, for the cameras that have colour
+    time : float, seconds since the recording's first frame: the device's timestamps
+        where the format has them, else ``index / fps``
     """
 
     index: int
     depth: dict[str, np.ndarray]
     color: dict[str, np.ndarray]
+    time: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -456,7 +459,7 @@ class Recording:
             c.name: (self.depth_raw(index, c.name) * c.depth_scale).astype(np.float32) for c in self.cameras
         }
         colors = {name: self.color(index, name) for name in self._color_names} if color else {}
-        return Frame(index=index, depth=depth, color=colors)
+        return Frame(index=index, depth=depth, color=colors, time=index / self.fps)
 
     def frames(self, *, color: bool = True) -> Iterator[Frame]:
         """Iterate over all frames in order, reading each when it is reached (`frame`)."""

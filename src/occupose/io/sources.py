@@ -62,10 +62,12 @@ class StreamSource:
 
     A subclass sets ``path``, ``fps``, ``num_frames`` and ``cameras`` (their world poses,
     the identity until placed, with ``pose_known`` False when the file has none) and
-    implements ``_raw_frames(color)``: an iterator of (depth, colour) per frame, depth a
-    dict camera name -> (H, W) uint16 raw units (metres = value * camera.depth_scale,
-    0 = none), colour a dict camera name -> (H, W, 3) uint8 RGB (empty when ``color`` is
-    False). ``gravity`` : dict camera name -> (3,) camera-frame direction of gravity from
+    implements ``_raw_frames(color)``: an iterator of (depth, colour, time) per frame,
+    depth a dict camera name -> (H, W) uint16 raw units (metres = value *
+    camera.depth_scale, 0 = none), colour a dict camera name -> (H, W, 3) uint8 RGB (empty
+    when ``color`` is False), time the frame's device timestamp in seconds (any origin: the
+    first frame's is subtracted) or None where the format has none (then index / fps).
+    ``gravity`` : dict camera name -> (3,) camera-frame direction of gravity from
     the file's IMU, where it has one (the floor estimate uses it).
     """
 
@@ -77,7 +79,8 @@ class StreamSource:
     gravity: Mapping[str, np.ndarray] = {}
     _color_names: tuple[str, ...] = ()
 
-    def _raw_frames(self, color: bool) -> Iterator[tuple[dict[str, np.ndarray], dict[str, np.ndarray]]]:
+    def _raw_frames(self, color: bool) -> Iterator[tuple[dict[str, np.ndarray], dict[str, np.ndarray],
+                                                          float | None]]:
         raise NotImplementedError
 
     def __repr__(self) -> str:
@@ -104,11 +107,17 @@ class StreamSource:
     def frames(self, *, color: bool = True) -> Iterator[Frame]:
         """Every frame in order: depth in float32 metres per camera, colour where there is any."""
         scales = {c.name: c.depth_scale for c in self.cameras}
-        for index, (raw, colors) in enumerate(self._raw_frames(color)):
+        start = None
+        for index, (raw, colors, time) in enumerate(self._raw_frames(color)):
             if index >= self.num_frames:
                 return
+            if time is None:
+                time = index / self.fps
+            elif start is None:
+                start = time
             depth = {name: (image * scales[name]).astype(np.float32) for name, image in raw.items()}
-            yield Frame(index=index, depth=depth, color=colors if color else {})
+            yield Frame(index=index, depth=depth, color=colors if color else {},
+                        time=float(time - (start or 0.0)))
 
     def frame(self, index: int, *, color: bool = True) -> Frame:
         """Frame ``index``, read by going through the frames before it."""
