@@ -33,7 +33,7 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 #: The file in an output folder that lists what occupose wrote there (JSON:
@@ -354,22 +354,23 @@ def picture_path(out: str | os.PathLike) -> Path:
 
 
 @contextlib.contextmanager
-def staged_picture(out: str | os.PathLike, *, force: bool = False,
-                   inputs: Iterable[str | os.PathLike] = ()) -> Iterator[Path]:
-    """A temporary name beside the picture file ``out`` (a :func:`picture_path`) to write
-    it to, renamed to ``out`` when the block ends without an exception. Checked first (the
-    overwrite rule: an existing file is refused without ``force``, and with it unless
-    :func:`is_occupose_picture`); parents of ``out`` made for it are removed on failure.
-    The writer must give the PNG the ``Software`` text :data:`SOFTWARE`."""
+def staged_file(out: str | os.PathLike, is_ours: Callable[[Path], bool], what: str, *, force: bool = False,
+                inputs: Iterable[str | os.PathLike] = ()) -> Iterator[Path]:
+    """A temporary name beside the single-file output ``out`` (a ``what``, e.g. "picture")
+    to write it to, renamed to ``out`` when the block ends without an exception. Checked
+    first (the overwrite rule: an existing file is refused without ``force``, and with it
+    unless ``is_ours(out)``, the writer's test that occupose wrote it); parents of ``out``
+    made for it are removed on failure. Raises :class:`OutputError` for a refusal or an
+    OS error on output."""
     out = Path(out)
     _check_inputs(out, inputs)
     _check_name(out)
     if out.is_dir():
-        raise OutputError(f"{out} is a folder; give the picture's file name")
+        raise OutputError(f"{out} is a folder; give the {what}'s file name")
     if os.path.lexists(out):
         if not force:
-            raise OutputError(f"{out} exists (use --force to replace a picture occupose made)")
-        if not is_occupose_picture(out):
+            raise OutputError(f"{out} exists (use --force to replace a {what} occupose made)")
+        if not is_ours(out):
             raise OutputError(f"{out} was not written by occupose: not replacing it, even with --force")
     _check_parents(out)
     made = []
@@ -387,5 +388,13 @@ def staged_picture(out: str | os.PathLike, *, force: bool = False,
         raise
 
 
+def staged_picture(out: str | os.PathLike, *, force: bool = False,
+                   inputs: Iterable[str | os.PathLike] = ()):
+    """:func:`staged_file` for the picture file ``out`` (a :func:`picture_path`), ours when
+    :func:`is_occupose_picture`. The writer must give the PNG the ``Software`` text
+    :data:`SOFTWARE`."""
+    return staged_file(out, is_occupose_picture, "picture", force=force, inputs=inputs)
+
+
 __all__ = ["KINDS", "MANIFEST", "SOFTWARE", "OutputError", "atomic_path", "check_output", "is_occupose_picture",
-           "link_tree", "picture_path", "read_manifest", "staged_folder", "staged_picture", "write_text"]
+           "link_tree", "picture_path", "read_manifest", "staged_file", "staged_folder", "staged_picture", "write_text"]
