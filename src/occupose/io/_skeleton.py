@@ -57,3 +57,8 @@ def metres_per_unit(units) -> float:
     if not scale > 0:
         raise ValueError(f"units must be positive metres per file unit, got {units!r}")
     return scale
+
+
+def yup_from_zup(points: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`zup_from_yup`: (x, y, z) z-up -> (x, z, -y) y-up."""
+    return points @ _ZUP_FROM_YUP
