@@ -257,14 +257,27 @@ def _layers_for(filter_name: str, layers):
     return None
 
 
-def run_tracking(rec, out: Path, config, method: str | None, seed: int, force: bool) -> tuple[Path, object]:
-    """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json (``out`` checked
-    first); returns (tracks path, result)."""
+def run_tracking(rec, out: Path, config, method: str | None, seed: int, force: bool, formats=(),
+                 frame: str = "world", camera: str | None = None) -> tuple[Path, object]:
+    """Track ``rec`` into ``out``/tracks.csv and ``out``/summary.json, and ``out``/tracks.<suffix>
+    of each of ``formats`` in ``frame`` (``out`` checked first); returns (tracks path, result)."""
     from occupose.run import track_into
 
     with _progress(f"tracking ({method or 'custom'})") as progress:
         return track_into(out, rec, config, method=method, seed=seed, force=force,
-                          progress=lambda n: progress(n, rec.num_frames))
+                          progress=lambda n: progress(n, rec.num_frames), formats=formats, frame=frame,
+                          camera=camera)
+
+
+def _output_formats() -> list[str]:
+    from occupose.io.writers import WRITERS
+
+    return list(WRITERS)
+
+
+#: --frame and --camera of the commands that write JSON, BVH or C3D.
+_FRAME_HELP = "Coordinates of the JSON, BVH or C3D output: world (z up, metres from the floor) or camera."
+_CAMERA_HELP = "The camera of --frame camera (default: the recording's first)."
 
 
 def _layers(text: str | None):
@@ -293,11 +306,18 @@ def _layers(text: str | None):
               help="TOML or JSON file of settings (see docs/configuration.md); options given here win.")
 @click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
               help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable; none for none).")
+@click.option("--format", "output_format", type=click.Choice(["csv", *_output_formats()]), default="csv",
+              show_default=True, help="Another output beside tracks.csv: OUT/tracks.json, .bvh or .c3d "
+              "(docs/outputs.md).")
+@click.option("--frame", type=click.Choice(["world", "camera"]), default="world", show_default=True,
+              help=_FRAME_HELP)
+@click.option("--camera", default=None, help=_CAMERA_HELP)
 @click.option("--force", is_flag=True, help=_FORCE_HELP)
 def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config_file,
-              assignments, force) -> None:
-    """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json and prints
-    the Table I row when the recording has ground truth."""
+              assignments, output_format, frame, camera, force) -> None:
+    """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json (and
+    OUT/tracks.FORMAT with --format) and prints the Table I row when the recording has
+    ground truth."""
     from occupose.io.recording import Recording
 
     values = {"pose.model": model, "pose.filter": filter_name, "pose.likelihood": likelihood,
@@ -307,7 +327,8 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
         rec = Recording(recording)
         if rec.num_frames == 0:
             _fail(f"{recording}: the recording has no frames, nothing to track")
-        tracks_path, result = run_tracking(rec, out, config, name, seed, force)
+        formats = () if output_format == "csv" else (output_format,)
+        tracks_path, result = run_tracking(rec, out, config, name, seed, force, formats, frame, camera)
         click.echo(f"{len(result.tracks)} track(s) in {result.num_frames} frames at {result.fps:.1f} frames/s "
                    f"-> {tracks_path}")
         if not result.tracks:
@@ -316,6 +337,27 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
             click.echo(score_text(rec, tracks_path))
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
+
+
+@main.command("export")
+@click.argument("tracks", type=click.Path(path_type=Path))
+@click.option("--to", "to", type=click.Choice(_output_formats()), required=True, help="The format to write.")
+@click.option("--out", type=click.Path(path_type=Path), required=True, help="The file to write.")
+@click.option("--frame", type=click.Choice(["world", "camera"]), default="world", show_default=True,
+              help=_FRAME_HELP)
+@click.option("--camera", default=None, help=_CAMERA_HELP)
+@click.option("--recording", type=click.Path(path_type=Path), default=None,
+              help="The recording the tracks are of (default: the one summary.json beside TRACKS names).")
+@click.option("--force", is_flag=True, help="Replace a file of that format that occupose wrote at OUT.")
+def export_cmd(tracks, to, out, frame, camera, recording, force) -> None:
+    """Write a run's TRACKS (its tracks.csv) as JSON, BVH or C3D (docs/outputs.md)."""
+    from occupose.io.export import export_tracks
+
+    try:
+        path = export_tracks(tracks, to, out, frame=frame, camera=camera, recording=recording, force=force)
+    except (ValueError, FileNotFoundError, ImportError) as error:
+        _fail(str(error))
+    click.echo(f"wrote {path}")
 
 
 @main.command("config")

@@ -14,7 +14,7 @@ import itertools
 import json
 import os
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -161,14 +161,25 @@ def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method
             "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
 
 
-def _write_run_files(folder: Path, result: TrackingResult, recording_path: str | os.PathLike,
-                     method: str | None) -> None:
-    """A run's tracks.csv and summary.json, into the (staged) ``folder``."""
+def _write_run_files(folder: Path, result: TrackingResult, recording, method: str | None,
+                     formats: Sequence[str] = (), frame: str = "world", camera: str | None = None) -> None:
+    """A run's tracks.csv and summary.json, and ``tracks.<suffix>`` of each of ``formats``
+    (:data:`occupose.io.writers.WRITERS`, in ``frame`` of ``camera``:
+    :func:`occupose.io.export.check_frame`), into the (staged) ``folder``. ``recording`` :
+    its path, or with ``formats`` the frame source itself (its fps, frames and cameras)."""
     from occupose.io.joint_table import write_tracks_csv
     from occupose.io.output import write_text
 
+    path = recording if isinstance(recording, (str, os.PathLike)) else recording.path
     write_tracks_csv(folder / "tracks.csv", result.tracks)
-    write_text(folder / "summary.json", json.dumps(summary_of(result, recording_path, method), indent=2) + "\n")
+    write_text(folder / "summary.json", json.dumps(summary_of(result, path, method), indent=2) + "\n")
+    if formats:
+        from occupose.io.export import tracks_for_output
+        from occupose.io.writers import write_tracks, writer_for
+
+        tracks = tracks_for_output(result.tracks, recording, frame, camera)
+        for name in formats:
+            write_tracks(folder / f"tracks{writer_for(name).suffix}", tracks, name)
 
 
 def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: str | os.PathLike,
@@ -185,16 +196,26 @@ def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: st
 
 
 def track_into(out: str | os.PathLike, recording, config: TrackerConfig | str = "ours", *, method: str | None = None,
-               seed: int = 0, force: bool = False, progress: Callable[[int], None] | None = None
+               seed: int = 0, force: bool = False, progress: Callable[[int], None] | None = None,
+               formats: Sequence[str] = (), frame: str = "world", camera: str | None = None
                ) -> tuple[Path, TrackingResult]:
     """:func:`track_recording`, then :func:`write_run` into ``out`` (``method`` names the
     config in the summary), with ``out`` checked and its hidden folder made before the
-    tracking starts, so a run is not lost to an output that cannot be written. Returns
-    (the tracks.csv path, the result)."""
+    tracking starts, so a run is not lost to an output that cannot be written. ``formats``
+    : other outputs beside tracks.csv, ``tracks.<suffix>`` of each
+    (:data:`occupose.io.writers.WRITERS`), in ``frame`` (``"world"`` or ``"camera"``, the
+    camera named or the first: :func:`occupose.io.export.check_frame`), all checked before
+    the tracking. Returns (the tracks.csv path, the result)."""
+    from occupose.io.export import check_frame
     from occupose.io.output import staged_folder
+    from occupose.io.writers import writer_for
 
     recording = _as_recording(recording)
+    formats = tuple(formats)
+    for name in formats:
+        writer_for(name)
+    check_frame(frame, camera, recording.cameras)
     with staged_folder(out, "run", force=force, inputs=(recording.path,)) as folder:
         result = track_recording(recording, config, seed=seed, progress=progress)
-        _write_run_files(folder, result, recording.path, method)
+        _write_run_files(folder, result, recording, method, formats, frame, camera)
     return Path(out) / "tracks.csv", result

@@ -12,9 +12,10 @@ both known), so the skeleton at rest is the track's mean shape.
 Units: centimetres. Axes: y up, as BVH expects: a world point (x, y, z), z up, is written
 (x, z, -y); a camera-frame point (OpenCV: x right, y down, z forward) is written (x, -y, -z).
 
-BVH cannot mark a joint missing. In a frame where a track's joint is unknown its bone is
-the mean vector (the OFFSET), and where the pelvis is unknown it is at the nearest frame's
-known pelvis (before it: the first known). Visibility is not in the file: use JSON or C3D.
+BVH cannot mark a joint missing. A known joint is written where it is, whatever is
+known of its parent; in a frame where a joint is unknown it is at its parent plus the
+OFFSET, and where the pelvis is unknown it is at the nearest earlier frame's known pelvis
+(before the first: the first; never known: the origin). Visibility is not in the file: use JSON or C3D.
 """
 
 from __future__ import annotations
@@ -76,23 +77,25 @@ def relative_channels(joints: np.ndarray, known: np.ndarray) -> tuple[np.ndarray
     """One track's BVH motion in its own frame's axes and units.
 
     joints : (T, 15, 3) positions, NaN where unknown; known : (T, 15) bool
-    Returns (offsets (15, 3): each joint's mean vector from its parent, the pelvis's 0;
-    channels (T, 15, 3): each joint's position relative to its parent's, the pelvis's
-    absolute, filled as the module docstring says).
+    Returns (offsets (15, 3): each joint's mean vector from its parent where both are
+    known, else 0, the pelvis's 0; channels (T, 15, 3): each joint's position relative to
+    its parent's as written, the pelvis's absolute). A known joint is written where it is;
+    an unknown one at its parent plus its offset, an unknown pelvis as the module says.
     """
     offsets = np.zeros((NUM_JOINTS, 3))
-    channels = np.zeros(joints.shape)
+    written = np.zeros(joints.shape)  # the positions the file gives, parent first
     for j in _ORDER:
         p = _PARENTS[j]
         if p < 0:
             if known[:, j].any():
-                channels[:, j] = _fill_nearest(joints[:, j], known[:, j])
+                written[:, j] = _fill_nearest(joints[:, j], known[:, j])
             continue
         both = known[:, j] & known[:, p]
-        vectors = joints[:, j] - joints[:, p]
         if both.any():
-            offsets[j] = vectors[both].mean(axis=0)
-        channels[:, j] = np.where(both[:, None], vectors, offsets[j])
+            offsets[j] = (joints[both, j] - joints[both, p]).mean(axis=0)
+        written[:, j] = np.where(known[:, j, None], joints[:, j], written[:, p] + offsets[j])
+    channels = written.copy()
+    channels[:, _ORDER[1:]] -= written[:, [_PARENTS[j] for j in _ORDER[1:]]]
     return offsets, channels
 
 

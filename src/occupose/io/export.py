@@ -1,0 +1,86 @@
+"""Writing a run's tracks in another format, at the end of a run or afterwards from its
+``tracks.csv`` (``occupose export``): the recording gives the frame count, the fps and,
+for the camera frame, the camera's pose."""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from occupose.io.writers import Tracks, tracks_from_table, tracks_in_camera, write_tracks, writer_for
+
+#: Values of ``frame``: the world (z up, floor at z = 0) or a camera's (OpenCV axes).
+FRAMES = ("world", "camera")
+
+
+def check_frame(frame: str, camera: str | None, cameras: Sequence) -> str | None:
+    """The camera whose frame the output is in for ``frame`` (:data:`FRAMES`) and an
+    optional camera ``name`` among ``cameras`` (objects with ``.name``): None for the
+    world, else the named camera or the first. ValueError for an unknown frame or camera,
+    or a camera named for the world frame."""
+    if frame not in FRAMES:
+        raise ValueError(f"unknown frame {frame!r}; valid: {', '.join(FRAMES)}")
+    names = [c.name for c in cameras]
+    if frame == "world":
+        if camera is not None:
+            raise ValueError(f"a camera ({camera!r}) is named only for the camera frame (frame 'camera')")
+        return None
+    if camera is None:
+        return names[0]
+    if camera not in names:
+        raise ValueError(f"no camera {camera!r} in the recording; its cameras are {', '.join(names)}")
+    return camera
+
+
+def tracks_for_output(table, recording, frame: str = "world", camera: str | None = None) -> Tracks:
+    """The joint table ``table`` ({id: (joints (T, 15, 3) metres, visible (T, 15) bool)}) of
+    ``recording`` (a frame source: ``num_frames``, ``fps``, ``cameras``, ``path``) as
+    :class:`Tracks` in ``frame`` (:func:`check_frame`)."""
+    name = check_frame(frame, camera, recording.cameras)
+    tracks = tracks_from_table(table, recording.num_frames, recording.fps, str(recording.path))
+    if name is None:
+        return tracks
+    pose = next(c.world_from_camera for c in recording.cameras if c.name == name)
+    return tracks_in_camera(tracks, np.asarray(pose), name)
+
+
+def recording_of_run(tracks_csv: Path) -> Path:
+    """The recording a run's ``tracks.csv`` came from, as the ``summary.json`` beside it names it."""
+    summary = tracks_csv.parent / "summary.json"
+    try:
+        data = json.loads(summary.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{summary}: no summary.json beside {tracks_csv.name} to name its recording; "
+                                "give the recording (--recording)") from None
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{summary}: not a readable summary of a run ({error}); give the recording "
+                         "(--recording)") from None
+    if not isinstance(data, dict) or not isinstance(data.get("recording"), str):
+        raise ValueError(f"{summary}: names no recording; give the recording (--recording)")
+    return Path(data["recording"])
+
+
+def export_tracks(tracks_csv: str | os.PathLike, to: str, out: str | os.PathLike, *, frame: str = "world",
+                  camera: str | None = None, recording: str | os.PathLike | None = None,
+                  force: bool = False) -> Path:
+    """Write the run's ``tracks_csv`` as ``to`` (:data:`occupose.io.writers.WRITERS`) to the
+    file ``out`` in ``frame`` (:func:`check_frame`), whole or not at all (``force``: replace
+    a file occupose wrote). ``recording`` : the recording the tracks are of (any format,
+    :func:`occupose.io.sources.open_source`), by default the one the run's summary.json
+    names (:func:`recording_of_run`). Returns ``out``."""
+    from occupose.io.joint_table import read_tracks_csv
+    from occupose.io.sources import open_source
+
+    writer_for(to)
+    tracks_csv = Path(tracks_csv)
+    if not tracks_csv.is_file():
+        raise FileNotFoundError(f"{tracks_csv}: no such tracks file")
+    source = open_source(recording if recording is not None else recording_of_run(tracks_csv))
+    check_frame(frame, camera, source.cameras)
+    table = read_tracks_csv(tracks_csv, source.num_frames)
+    tracks = tracks_for_output(table, source, frame, camera)
+    return write_tracks(out, tracks, to, force=force, inputs=(tracks_csv, source.path))
