@@ -125,3 +125,13 @@ def test_track_format_refuses_an_unknown_camera_before_tracking(run, tmp_path):
                                        "--frame", "camera", "--camera", "top"])
     assert result.exit_code != 0 and "no camera 'top' in the recording" in result.output
     assert not (tmp_path / "o").exists()
+
+
+def test_track_format_with_nobody_tracked_says_no_file_was_written(tmp_path, small_camera):
+    rec = tmp_path / "rec"
+    with RecordingWriter(rec, [small_camera], 30.0) as writer:
+        writer.write_frame({"cam": np.zeros((120, 160), np.uint16)})
+    result = CliRunner().invoke(main, ["track", str(rec), "--out", str(tmp_path / "o"), "--format", "c3d"])
+    assert result.exit_code == 0, result.output
+    assert "nobody was tracked" in result.output and "no tracks.c3d written" in result.output
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == [MANIFEST, "summary.json", "tracks.csv"]

@@ -332,7 +332,8 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
         click.echo(f"{len(result.tracks)} track(s) in {result.num_frames} frames at {result.fps:.1f} frames/s "
                    f"-> {tracks_path}")
         if not result.tracks:
-            click.echo("nobody was tracked (no moving person-sized blob in the recording)")
+            click.echo("nobody was tracked (no moving person-sized blob in the recording)"
+                       + (f": no tracks.{output_format} written" if output_format != "csv" else ""))
         if rec.has_groundtruth:
             click.echo(score_text(rec, tracks_path))
     except (ValueError, FileNotFoundError) as error:

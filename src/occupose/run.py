@@ -165,7 +165,7 @@ def _write_run_files(folder: Path, result: TrackingResult, recording, method: st
                      formats: Sequence[str] = (), frame: str = "world", camera: str | None = None) -> None:
     """A run's tracks.csv and summary.json, and ``tracks.<suffix>`` of each of ``formats``
     (:data:`occupose.io.writers.WRITERS`, in ``frame`` of ``camera``:
-    :func:`occupose.io.export.check_frame`), into the (staged) ``folder``. ``recording`` :
+    :func:`occupose.io.export.check_frame`) when anybody was tracked, into the (staged) ``folder``. ``recording`` :
     its path, or with ``formats`` the frame source itself (its fps, frames and cameras)."""
     from occupose.io.joint_table import write_tracks_csv
     from occupose.io.output import write_text
@@ -173,7 +173,7 @@ def _write_run_files(folder: Path, result: TrackingResult, recording, method: st
     path = recording if isinstance(recording, (str, os.PathLike)) else recording.path
     write_tracks_csv(folder / "tracks.csv", result.tracks)
     write_text(folder / "summary.json", json.dumps(summary_of(result, path, method), indent=2) + "\n")
-    if formats:
+    if formats and result.tracks:
         from occupose.io.export import tracks_for_output
         from occupose.io.writers import write_tracks, writer_for
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 import pytest
@@ -161,3 +162,20 @@ def test_tracks_from_table_checks_its_input(standing_skeleton):
         tracks_from_table({1: (joints, np.ones((2, 15), bool))}, 2, 0.0)
     with pytest.raises(ValueError, match="track 1 joints must have shape \\(3, 15, 3\\)"):
         tracks_from_table({1: (joints, np.ones((2, 15), bool))}, 3, FPS)
+
+
+def test_c3d_without_its_package_names_the_extra(tmp_path, tracks, monkeypatch):
+    monkeypatch.setitem(sys.modules, "c3d", None)  # as if not installed
+    with pytest.raises(ImportError, match=r"writing C3D files needs the 'c3d' package .*pip install 'occupose\[c3d\]'"):
+        write_tracks(tmp_path / "t.c3d", tracks, "c3d")
+    assert not any(tmp_path.iterdir())
+
+
+def test_no_tracks_give_json_and_bvh_without_bodies_and_no_c3d(tmp_path):
+    empty = tracks_from_table({}, 3, FPS)
+    data = json.loads(write_tracks(tmp_path / "e.json", empty, "json").read_text())
+    assert [f["num_bodies"] for f in data["frames"]] == [0, 0, 0]
+    assert _bvh_positions(write_tracks(tmp_path / "e.bvh", empty, "bvh"), 3).keys() == {"world"}
+    with pytest.raises(ValueError, match="no track to write: a C3D file needs at least one marker"):
+        write_tracks(tmp_path / "e.c3d", empty, "c3d")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.bvh", "e.json"]

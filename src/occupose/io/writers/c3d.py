@@ -45,9 +45,12 @@ def points_from_tracks(tracks: Tracks) -> np.ndarray:
 
 
 def write_c3d(path: Path, tracks: Tracks) -> None:
-    """Write ``tracks`` as C3D to ``path`` (module docstring)."""
+    """Write ``tracks`` as C3D to ``path`` (module docstring); ValueError without a track
+    (a C3D file needs at least one marker)."""
     from occupose.io.sources import require
 
+    if not len(tracks.ids):
+        raise ValueError("no track to write: a C3D file needs at least one marker")
     c3d = require("c3d", "c3d", "writing C3D files")
     writer = c3d.Writer(point_rate=float(tracks.fps), point_units="mm  ")
     analog = np.zeros((0, 0), np.float32)
