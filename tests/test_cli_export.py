@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 import pytest
@@ -135,3 +136,11 @@ def test_track_format_with_nobody_tracked_says_no_file_was_written(tmp_path, sma
     assert result.exit_code == 0, result.output
     assert "nobody was tracked" in result.output and "no tracks.c3d written" in result.output
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == [MANIFEST, "summary.json", "tracks.csv"]
+
+
+def test_track_format_c3d_without_its_package_names_the_extra_and_leaves_no_output(run, tmp_path, monkeypatch):
+    rec_path, _ = run
+    monkeypatch.setitem(sys.modules, "c3d", None)  # as if not installed
+    result = CliRunner().invoke(main, ["track", str(rec_path), "--out", str(tmp_path / "o"), "--format", "c3d"])
+    assert result.exit_code != 0 and "pip install 'occupose[c3d]'" in result.output
+    assert not (tmp_path / "o").exists()

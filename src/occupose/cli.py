@@ -336,7 +336,7 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
                        + (f": no tracks.{output_format} written" if output_format != "csv" else ""))
         if rec.has_groundtruth:
             click.echo(score_text(rec, tracks_path))
-    except (ValueError, FileNotFoundError) as error:
+    except (ValueError, FileNotFoundError, ImportError) as error:
         _fail(str(error))
 
 

@@ -165,8 +165,9 @@ def _write_run_files(folder: Path, result: TrackingResult, recording, method: st
                      formats: Sequence[str] = (), frame: str = "world", camera: str | None = None) -> None:
     """A run's tracks.csv and summary.json, and ``tracks.<suffix>`` of each of ``formats``
     (:data:`occupose.io.writers.WRITERS`, in ``frame`` of ``camera``:
-    :func:`occupose.io.export.check_frame`) when anybody was tracked, into the (staged) ``folder``. ``recording`` :
-    its path, or with ``formats`` the frame source itself (its fps, frames and cameras)."""
+    :func:`occupose.io.export.check_frame`) when anybody was tracked, into the (staged)
+    ``folder``. ``recording`` : its path, or with ``formats`` the frame source itself (its
+    fps, frames and cameras)."""
     from occupose.io.joint_table import write_tracks_csv
     from occupose.io.output import write_text
 
@@ -205,7 +206,7 @@ def track_into(out: str | os.PathLike, recording, config: TrackerConfig | str = 
     : other outputs beside tracks.csv, ``tracks.<suffix>`` of each
     (:data:`occupose.io.writers.WRITERS`), in ``frame`` (``"world"`` or ``"camera"``, the
     camera named or the first: :func:`occupose.io.export.check_frame`), all checked before
-    the tracking. Returns (the tracks.csv path, the result)."""
+    the tracking (their optional packages too). Returns (the tracks.csv path, the result)."""
     from occupose.io.export import check_frame
     from occupose.io.output import staged_folder
     from occupose.io.writers import writer_for
@@ -213,7 +214,7 @@ def track_into(out: str | os.PathLike, recording, config: TrackerConfig | str = 
     recording = _as_recording(recording)
     formats = tuple(formats)
     for name in formats:
-        writer_for(name)
+        writer_for(name).check_available()
     check_frame(frame, camera, recording.cameras)
     with staged_folder(out, "run", force=force, inputs=(recording.path,)) as folder:
         result = track_recording(recording, config, seed=seed, progress=progress)

@@ -75,7 +75,7 @@ def export_tracks(tracks_csv: str | os.PathLike, to: str, out: str | os.PathLike
     from occupose.io.joint_table import read_tracks_csv
     from occupose.io.sources import open_source
 
-    writer_for(to)
+    writer_for(to).check_available()
     tracks_csv = Path(tracks_csv)
     if not tracks_csv.is_file():
         raise FileNotFoundError(f"{tracks_csv}: no such tracks file")

@@ -95,6 +95,7 @@ class Writer:
     summary : one line for help texts
     write : callable(path, tracks) writing the whole file at ``path`` (a temporary name)
     is_ours : callable(path) -> bool, whether a file there is one occupose wrote
+    needs : (module, install extra) of an optional package the writer imports, or None
     """
 
     name: str
@@ -102,6 +103,14 @@ class Writer:
     summary: str
     write: Callable[[Path, Tracks], None]
     is_ours: Callable[[Path], bool]
+    needs: tuple[str, str] | None = None
+
+    def check_available(self) -> None:
+        """Raise the ImportError naming the extra to install when the package it needs is missing."""
+        if self.needs is not None:
+            from occupose.io.sources import require
+
+            require(*self.needs, f"writing {self.name.upper()} files")
 
 
 WRITERS: dict[str, Writer] = {}
@@ -143,7 +152,7 @@ def _register() -> None:
     register_writer(Writer("bvh", ".bvh", "BVH, positions in 6 channels per joint (cm, y up)",
                            bvh.write_bvh, bvh.is_occupose_bvh))
     register_writer(Writer("c3d", ".c3d", "C3D markers (mm, z up; residual -1 hidden)",
-                           c3d.write_c3d, c3d.is_occupose_c3d))
+                           c3d.write_c3d, c3d.is_occupose_c3d, needs=("c3d", "c3d")))
 
 
 _register()
