@@ -574,6 +574,36 @@ class RecoverConfig(_Section):
 
 
 @dataclass(frozen=True)
+class FloorConfig(_Section):
+    """Placing a camera of a recording without a world pose from the floor seen in its first
+    frames (``occupose.geometry.floor``, ``occupose.io.sources.place_from_floor``)."""
+
+    _path = "floor"
+    frames: int = setting(15, "first frames whose per-pixel median depth the floor is fitted to (a person moving "
+                                "through them is left out)", "frames", low=1)
+    points: int = setting(20000, "points of that median image the planes are fitted to (evenly taken)", "points",
+                          low=3)
+    iterations: int = setting(300, "RANSAC plane hypotheses per plane found", "count", low=1)
+    planes: int = setting(5, "largest planes found, one after another, as floor candidates", "count", low=1)
+    tolerance_m: float = setting(0.02, "a point lies on a plane within this ...", "m", above=0)
+    tolerance_rel: float = setting(0.01, "... plus this share of its depth (sensor noise grows with depth)",
+                                   "share", low=0)
+    min_share: float = setting(0.05, "least share of the points on a plane that can be the floor", "share",
+                               low=0, high=1)
+    max_below: float = setting(0.02, "most share of the points beyond a floor candidate (nothing is seen below "
+                                     "the floor)", "share", low=0, high=1)
+    min_height: float = setting(0.1, "lowest camera height above a floor candidate", "m", low=0)
+    max_height: float = setting(6.0, "highest camera height above a floor candidate", "m", above=0)
+    image_up: float = setting(0.5, "without an IMU, a candidate's score is its share times this plus how far its "
+                                   "normal points up the image (a camera is mounted image-up: the floor is "
+                                   "toward the image's bottom or straight ahead, never at its top)", "", low=0)
+    parallel_deg: float = setting(5.0, "a plane within this of the chosen floor's orientation and lower is the "
+                                       "floor instead (the chosen one is a table top)", "deg", low=0, high=90)
+    gravity_deg: float = setting(15.0, "with an IMU, the floor's normal lies within this of the measured up "
+                                       "direction", "deg", low=0, high=90)
+
+
+@dataclass(frozen=True)
 class LimitsConfig(_Section):
     """Bounds on what a run may cost and on what its cameras may be, checked before any work
     (``occupose.bounds``, ``occupose.grid.occupancy.spec_from_cameras``): a setting or a
@@ -630,6 +660,7 @@ class TrackerConfig(_Section):
     proposals: ProposalConfig = field(default_factory=ProposalConfig)
     occlusion: OcclusionConfig = field(default_factory=OcclusionConfig)
     recover: RecoverConfig = field(default_factory=RecoverConfig)
+    floor: FloorConfig = field(default_factory=FloorConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
 
     def _check(self) -> None:

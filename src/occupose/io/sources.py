@@ -16,6 +16,7 @@ its own frames.
 from __future__ import annotations
 
 import importlib
+import itertools
 import json
 import math
 import os
@@ -25,7 +26,7 @@ from typing import Any, Callable, Iterator, Mapping, Protocol, Sequence, runtime
 
 import numpy as np
 
-from occupose.camera import Camera, look_at
+from occupose.camera import Camera, look_at, raw_depth_from_metres
 from occupose.io.recording import Frame
 
 
@@ -129,12 +130,14 @@ class StreamSource:
                 return frame
         raise SourceError(f"{self.path}: the recording ended before frame {index}")
 
-    def placed(self, poses: Mapping[str, np.ndarray]) -> StreamSource:
-        """A copy whose cameras have the world poses ``poses`` (camera name -> (4, 4))."""
+    def placed(self, poses: Mapping[str, np.ndarray], origin: str = "given") -> StreamSource:
+        """A copy whose cameras have the world poses ``poses`` (camera name -> (4, 4)),
+        which came from ``origin`` (``given``, ``floor``; see :func:`placement`)."""
         copy = object.__new__(type(self))
         copy.__dict__.update(self.__dict__)
         copy.cameras = [replace(c, world_from_camera=poses[c.name]) for c in self.cameras]
         copy.pose_known = True
+        copy.pose_from = origin
         return copy
 
 
@@ -248,34 +251,93 @@ def reader_for(path: str | os.PathLike, format: str | None = None) -> Reader:
 
 
 def open_source(path: str | os.PathLike, *, format: str | None = None, pose: HeightTilt | str | os.PathLike |
-                None = None, **options) -> FrameSource:
+                None = None, find_floor: bool = False, floor=None, **options) -> FrameSource:
     """Open the recording at ``path`` with its reader (:func:`reader_for`), its cameras placed.
 
     format : a :data:`READERS` name, or None to recognise it from the path
     pose : for a recording without a world pose: a :class:`HeightTilt` (every camera), a
-        JSON pose file (:func:`pose_from_file`), or None to find the floor in its frames.
-        A recording that has a pose keeps it; a pose given for one is an error.
+        JSON pose file (:func:`pose_from_file`), or None to find the floor in its frames
+        (:func:`place_from_floor`). A recording that has a pose keeps it; a pose given for
+        one is an error.
+    find_floor : place the cameras from the floor even when the recording has a pose
+    floor : the :class:`occupose.config.FloorConfig` of the floor estimate (None: the default)
     options : the reader's own (``topic`` for bags, ``camera`` for TUM folders, ...)
     """
     source = reader_for(path, format).open(Path(path), **options)
+    if find_floor:
+        if pose is not None:
+            raise SourceError(f"{path}: give either a pose or find_floor, not both")
+        return place_from_floor(without_pose(source), floor)
     if getattr(source, "pose_known", True):
         if pose is not None:
             raise SourceError(f"{path}: the recording has its own world pose; drop the pose option")
         return source
     names = [c.name for c in source.cameras]
     if isinstance(pose, HeightTilt):
-        return source.placed(dict.fromkeys(names, pose.world_from_camera()))
+        return source.placed(dict.fromkeys(names, pose.world_from_camera()), "given")
     if pose is not None:
-        return source.placed(pose_from_file(pose, names))
-    return place_from_floor(source)
+        return source.placed(pose_from_file(pose, names), "given")
+    return place_from_floor(source, floor)
 
 
-def place_from_floor(source: StreamSource) -> StreamSource:
-    """``source`` with each camera placed from the floor seen in its first frames."""
-    raise NoWorldPoseError(
-        f"{source.path}: the recording has no world pose (z up, the floor at z = 0) and finding the floor "
-        "in its frames is not available yet; give it with --camera-height H --tilt DEGREES or "
-        "--world-from-camera FILE.json")
+def place_from_floor(source: StreamSource, config=None) -> StreamSource:
+    """``source`` with its camera placed from the floor seen in its first frames
+    (:func:`occupose.geometry.floor.find_floor`, gravity from ``source.gravity``).
+    NoWorldPoseError when no floor is found, or for several cameras (their relative poses
+    are not known)."""
+    from occupose.config import FloorConfig
+    from occupose.geometry.floor import find_floor
+
+    config = FloorConfig() if config is None else config
+    give = "give it with --camera-height H --tilt DEGREES or --world-from-camera FILE.json"
+    if len(source.cameras) != 1:
+        raise NoWorldPoseError(f"{source.path}: the recording has no world pose and {len(source.cameras)} cameras "
+                               f"(the floor places one camera, not their poses to each other); {give}")
+    camera = source.cameras[0]
+    depths = (f.depth[camera.name] for f in itertools.islice(source.frames(color=False), config.frames))
+    floor = find_floor(camera, depths, config, gravity=source.gravity.get(camera.name))
+    if floor is None:
+        raise NoWorldPoseError(f"{source.path}: the recording has no world pose (z up, the floor at z = 0) and no "
+                               f"floor was found in its first {config.frames} frames (a plane with at least "
+                               f"{config.min_share:.0%} of the points, nothing beyond it, the camera "
+                               f"{config.min_height:g}-{config.max_height:g} m above it); {give}")
+    return source.placed({camera.name: floor.world_from_camera()}, "floor")
+
+
+def placement(source: FrameSource) -> list[dict[str, Any]]:
+    """Each camera's pose as a user reads it: ``name``, ``height_m`` (above the floor z = 0),
+    ``tilt_deg`` (the optical axis below the horizontal), ``roll_deg`` and ``pose`` (where
+    it came from: ``recording``, ``given`` or ``floor``)."""
+    origin = getattr(source, "pose_from", "recording")
+    entries = []
+    for camera in source.cameras:
+        pose = camera.world_from_camera
+        entries.append({"name": camera.name, "height_m": round(float(pose[2, 3]), 4),
+                        "tilt_deg": round(math.degrees(math.asin(np.clip(-pose[2, 2], -1, 1))), 3),
+                        "roll_deg": round(math.degrees(math.asin(np.clip(pose[2, 0], -1, 1))), 3),
+                        "pose": origin})
+    return entries
+
+
+class _Unplaced(StreamSource):
+    """Any frame source's frames, its cameras' poses forgotten (:func:`without_pose`)."""
+
+    def __init__(self, source: FrameSource):
+        self.path, self.fps, self.num_frames = source.path, source.fps, source.num_frames
+        self.cameras = [replace(c, world_from_camera=np.eye(4)) for c in source.cameras]
+        self._color_names = tuple(source.color_cameras)
+        self.gravity = dict(getattr(source, "gravity", {}))
+        self._source = source
+
+    def _raw_frames(self, color):
+        for frame in self._source.frames(color=color):
+            yield ({c.name: raw_depth_from_metres(frame.depth[c.name], c) for c in self.cameras}, frame.color,
+                   frame.time)
+
+
+def without_pose(source: FrameSource) -> StreamSource:
+    """``source`` as a recording without a world pose (to place it from its floor)."""
+    return _Unplaced(source)
 
 
 def lazy(module: str, function: str) -> Callable[..., Any]:
