@@ -127,21 +127,68 @@ def synth_cmd(name, out, seed, frames, sensor, procedural, force) -> None:
     _write_synth(name, out, seed, frames, sensor, force, procedural)
 
 
+def _source_options(command):
+    """The options of a command that reads a recording of any format (``_open``)."""
+    from occupose.io.sources import READERS
+
+    options = [
+        click.option("--reader", type=click.Choice(list(READERS)), default=None,
+                     help="The recording's format (default: recognised from the path)."),
+        click.option("--topic", default=None, help="ROS bags: the depth image topic (default: the only one)."),
+        click.option("--camera-height", type=click.FloatRange(min=0, min_open=True), default=None,
+                     help="A recording without a world pose: the camera's height above the floor, metres "
+                          "(with --tilt; default: found from the floor in its first frames)."),
+        click.option("--tilt", type=click.FloatRange(-90, 90), default=None,
+                     help="... and its optical axis' angle below the horizontal, degrees (90: straight down)."),
+        click.option("--world-from-camera", "pose_file", type=click.Path(exists=True, dir_okay=False,
+                     path_type=Path), default=None,
+                     help="A recording without a world pose: a JSON file of its cameras' poses "
+                          "(docs/inputs.md)."),
+        click.option("--find-floor", is_flag=True,
+                     help="Place the camera from the floor in its frames even when the recording has a pose."),
+    ]
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
+def _open(recording: Path, reader=None, topic=None, camera_height=None, tilt=None, pose_file=None,
+          find_floor=False, floor=None):
+    """The recording at ``recording`` (any format) with its cameras placed (the
+    ``_source_options``); a pose found from the floor or given is printed to stderr."""
+    from occupose.io.sources import HeightTilt, open_source, placement
+
+    if (camera_height is None) != (tilt is None):
+        _fail("--camera-height and --tilt go together")
+    if camera_height is not None and pose_file is not None:
+        _fail("give the pose with either --camera-height and --tilt or --world-from-camera, not both")
+    pose = HeightTilt(camera_height, tilt) if camera_height is not None else pose_file
+    options = {} if topic is None else {"topic": topic}
+    source = open_source(recording, format=reader, pose=pose, find_floor=find_floor, floor=floor, **options)
+    for entry in placement(source):
+        if entry["pose"] != "recording":
+            click.echo(f"{entry['name']}: {entry['height_m']:.3f} m above the floor, tilted {entry['tilt_deg']:.1f} "
+                       f"deg down, roll {entry['roll_deg']:.1f} deg ({'found from the floor' if entry['pose'] == 'floor' else 'given'})",
+                       err=True)
+    return source
+
+
 @main.command("show")
-@click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.argument("recording", type=click.Path(exists=True, path_type=Path))
+@_source_options
 @click.option("--frame", "index", type=click.IntRange(min=0), default=0, show_default=True)
 @click.option("--out", type=click.Path(path_type=Path), required=True,
               help="PNG file to write (.png is appended to a name without a suffix).")
 @click.option("--tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="A tracks.csv to draw beside the ground truth.")
 @click.option("--force", is_flag=True, help=_FORCE_HELP)
-def show_cmd(recording, index, out, tracks, force) -> None:
-    """Write a PNG of one frame: depth colour-mapped, skeletons drawn over it."""
-    from occupose.io.recording import Recording
+def show_cmd(recording, index, out, tracks, force, **source) -> None:
+    """Write a PNG of one frame of RECORDING (any format, docs/inputs.md): depth
+    colour-mapped, skeletons drawn over it."""
     from occupose.viz import show_frame
 
     try:
-        rec = Recording(recording)
+        rec = _open(recording, **source)
         track_data = _read_tracks(tracks, rec.num_frames, allow_unmarked=True) if tracks else None
         path = show_frame(rec, index, out, track_data, force=force)
     except (ValueError, FileNotFoundError) as error:
@@ -150,16 +197,15 @@ def show_cmd(recording, index, out, tracks, force) -> None:
 
 
 @main.command("score")
-@click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.argument("recording", type=click.Path(exists=True, path_type=Path))
+@_source_options
 @click.argument("tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--unmarked", is_flag=True, help="Score a tracks.csv without the end line occupose writes (one "
               "another program wrote), with a warning: a file cut short at a line boundary looks the same.")
-def score_cmd(recording, tracks, unmarked) -> None:
+def score_cmd(recording, tracks, unmarked, **source) -> None:
     """Print the Table I row of TRACKS (a tracks.csv) against RECORDING's ground truth."""
-    from occupose.io.recording import Recording
-
     try:
-        click.echo(score_text(Recording(recording), tracks, allow_unmarked=unmarked))
+        click.echo(score_text(_open(recording, **source), tracks, allow_unmarked=unmarked))
     except (ValueError, FileNotFoundError) as error:
         _fail(str(error))
 
@@ -292,7 +338,8 @@ def _layers(text: str | None):
 
 
 @main.command("track")
-@click.argument("recording", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.argument("recording", type=click.Path(exists=True, path_type=Path))
+@_source_options
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Folder for tracks.csv and summary.json.")
 @click.option("--method", default=None, help="ours (default), apf, ps or part-based: the base of the settings.")
 @click.option("--model", type=click.Choice(["auto", "full", "upper"]), default=None,
@@ -314,17 +361,15 @@ def _layers(text: str | None):
 @click.option("--camera", default=None, help=_CAMERA_HELP)
 @click.option("--force", is_flag=True, help=_FORCE_HELP)
 def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config_file,
-              assignments, output_format, frame, camera, force) -> None:
-    """Track everyone in RECORDING: writes OUT/tracks.csv and OUT/summary.json (and
-    OUT/tracks.FORMAT with --format) and prints the Table I row when the recording has
-    ground truth."""
-    from occupose.io.recording import Recording
-
+              assignments, output_format, frame, camera, force, **source) -> None:
+    """Track everyone in RECORDING (any format, docs/inputs.md): writes OUT/tracks.csv and
+    OUT/summary.json (and OUT/tracks.FORMAT with --format) and prints the Table I row when
+    the recording has ground truth."""
     values = {"pose.model": model, "pose.filter": filter_name, "pose.likelihood": likelihood,
               "pose.particles": particles, "pose.layers": _layers(layers)}
     config, name = build_config(config_file, method, values, assignments)
     try:
-        rec = Recording(recording)
+        rec = _open(recording, floor=config.floor, **source)
         if rec.num_frames == 0:
             _fail(f"{recording}: the recording has no frames, nothing to track")
         formats = () if output_format == "csv" else (output_format,)
@@ -338,6 +383,28 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
             click.echo(score_text(rec, tracks_path))
     except (ValueError, FileNotFoundError, ImportError) as error:
         _fail(str(error))
+
+
+@main.command("convert")
+@click.argument("recording", type=click.Path(exists=True, path_type=Path))
+@click.argument("out", type=click.Path(path_type=Path))
+@_source_options
+@click.option("--no-color", is_flag=True, help="Leave the colour images out.")
+@click.option("--force", is_flag=True, help="Replace a recording occupose wrote at OUT (only the files it wrote).")
+def convert_cmd(recording, out, no_color, force, **source) -> None:
+    """Write RECORDING (any format, docs/inputs.md) as occupose's recording folder OUT,
+    its cameras placed (the pose found from the floor is written into recording.json)."""
+    from occupose.io.convert import convert
+    from occupose.io.sources import reader_for
+
+    try:
+        rec = _open(recording, **source)
+        with _progress("converting") as progress:
+            convert(rec, out, reader=reader_for(recording, source["reader"]).name, color=not no_color, force=force,
+                    progress=lambda n: progress(n, rec.num_frames))
+    except (ValueError, FileNotFoundError, ImportError) as error:
+        _fail(str(error))
+    click.echo(f"wrote {out} ({rec.num_frames} frames, cameras {', '.join(c.name for c in rec.cameras)})")
 
 
 @main.command("export")

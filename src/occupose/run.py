@@ -42,6 +42,8 @@ class TrackingResult:
     overlap : whether the grid ran a frame ahead on a second thread (its hold mask then
         comes from the bodies one frame older, so the tracks may differ)
     noise : camera name -> what the grid assumed of it (:meth:`occupose.grid.noise.CameraNoise.to_dict`)
+    cameras : each camera's height, tilt, roll and where its pose came from
+        (:func:`occupose.io.sources.placement`)
     """
 
     tracks: dict[int, tuple[np.ndarray, np.ndarray]]
@@ -53,6 +55,7 @@ class TrackingResult:
     model: str = ""
     overlap: bool = False
     noise: dict[str, dict] = field(default_factory=dict)
+    cameras: list[dict] = field(default_factory=list)
 
 
 def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: Callable[[int], None] | None = None,
@@ -135,6 +138,7 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     when the recording was opened).
     """
     from occupose.io.prefetch import Prefetch
+    from occupose.io.sources import placement
 
     recording = _as_recording(recording)
     config = as_config(config)
@@ -147,16 +151,20 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
         noise = measure_noise(recording.cameras, first, config.grid)
     tracker = Tracker(recording.cameras, recording.fps, config, seed=seed, noise=noise)
     with Prefetch(recording.frames(color=False)) as frames:  # the next frames decoded while this one is tracked
-        return track_frames(tracker, frames, recording.num_frames, progress, overlap=overlap)
+        result = track_frames(tracker, frames, recording.num_frames, progress, overlap=overlap)
+    result.cameras = placement(recording)
+    return result
 
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:
     """The ``summary.json`` of a run: the recording, the method's name (if it was run as
     one: the base of its config), seed, body model, the whole resolved config, whether the
-    grid ran ahead on a thread, each camera's noise model and far range, frames, people,
-    seconds per stage and frames/s (start-up excluded)."""
+    grid ran ahead on a thread, each camera's noise model and far range and its pose (height,
+    tilt, roll, and whether the recording had it, it was given or found from the floor),
+    frames, people, seconds per stage and frames/s (start-up excluded)."""
     return {"recording": str(recording_path), "method": method, "seed": result.seed, "model": result.model,
             "config": result.config.to_dict(), "overlap": result.overlap, "noise": result.noise,
+            "cameras": result.cameras,
             "frames": result.num_frames, "people": len(result.tracks),
             "seconds": {k: round(v, 4) for k, v in result.seconds.items()}, "fps": round(result.fps, 2)}
 

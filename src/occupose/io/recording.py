@@ -44,6 +44,9 @@ FORMAT = "occupose-recording"
 VERSION = 1
 SUPPORTED_VERSIONS: tuple[int, ...] = (1,)
 RECORDING_KEYS: tuple[str, ...] = ("format", "version", "fps", "num_frames", "cameras")
+#: Keys a recording.json may have besides: ``origin``, what a converted recording was made
+#: from (``{"source": path, "reader": name, "cameras": [height, tilt, roll, pose of each]}``).
+OPTIONAL_KEYS: tuple[str, ...] = ("origin",)
 
 _JSON_NAME = "recording.json"
 _GROUNDTRUTH_NAME = "groundtruth.csv"
@@ -112,8 +115,10 @@ class RecordingWriter:
     exception leaves the folder without it, i.e. not a readable recording.
     """
 
-    def __init__(self, path: str | os.PathLike, cameras: Sequence[Camera], fps: float):
+    def __init__(self, path: str | os.PathLike, cameras: Sequence[Camera], fps: float, *,
+                 origin: Mapping | None = None):
         self.path = Path(path)
+        self.origin = None if origin is None else dict(origin)  # recording.json's optional "origin"
         cameras = list(cameras)
         if not cameras or not all(isinstance(c, Camera) for c in cameras):
             raise ValueError(f"cameras must be a non-empty list of Camera, got {cameras!r}")
@@ -241,7 +246,8 @@ class RecordingWriter:
                 f"the recording {self.num_frames}"
             )
         # one camera per line, as in DESIGN.md, rather than one number per line
-        head = json.dumps({"format": FORMAT, "version": VERSION, "fps": self.fps, "num_frames": self.num_frames})
+        head = {"format": FORMAT, "version": VERSION, "fps": self.fps, "num_frames": self.num_frames}
+        head = json.dumps(head if self.origin is None else dict(head, origin=self.origin))
         cameras = ",\n  ".join(json.dumps(c.to_dict()) for c in self.cameras)
         write_text(self.path / _JSON_NAME, f'{head[:-1]},\n "cameras": [\n  {cameras}\n ]}}\n')
         self._closed = True
@@ -279,9 +285,10 @@ def _read_header(file: Path) -> tuple[float, int, list[Camera]]:
     missing = [k for k in RECORDING_KEYS if k not in header]
     if missing:
         raise RecordingError(f"{file}: missing key(s) {missing}; a recording needs {list(RECORDING_KEYS)}")
-    unknown = sorted(set(header) - set(RECORDING_KEYS))
+    unknown = sorted(set(header) - set(RECORDING_KEYS) - set(OPTIONAL_KEYS))
     if unknown:
-        raise RecordingError(f"{file}: unknown key(s) {unknown}; a recording has exactly {list(RECORDING_KEYS)}")
+        raise RecordingError(f"{file}: unknown key(s) {unknown}; a recording has {list(RECORDING_KEYS)} "
+                             f"and may have {list(OPTIONAL_KEYS)}")
     fps, num_frames, entries = header["fps"], header["num_frames"], header["cameras"]
     if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0 < fps <= sys.float_info.max:
         raise RecordingError(f"{file}: \"fps\" must be a positive number, got {fps!r}")

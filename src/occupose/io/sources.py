@@ -98,6 +98,10 @@ class StreamSource:
         """Recordings of other formats carry no ground truth."""
         return False
 
+    def groundtruth(self):
+        """Recordings of other formats carry no ground truth: FileNotFoundError."""
+        raise FileNotFoundError(f"{self.path}: a recording of this format has no ground truth")
+
     def camera(self, name: str) -> Camera:
         """The camera called ``name``."""
         for camera in self.cameras:

@@ -1,0 +1,91 @@
+"""track, convert, show and score read a recording of any format and place one without a
+world pose: from the floor in its frames, or from a pose given on the command line."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from occupose.camera import raw_depth_from_metres
+from occupose.cli import main
+from occupose.io.recording import Recording, RecordingWriter
+from occupose.io.sources import HeightTilt
+
+FRAMES = 20
+FAST = ["--particles", "100", "--layers", "2,1,1", "--set", "start.samples=30"]
+
+
+@pytest.fixture(scope="module")
+def rec(tmp_path_factory, walk):
+    scenario, rendered = walk
+    path = tmp_path_factory.mktemp("sources") / "rec"
+    with RecordingWriter(path, list(scenario.cameras), scenario.fps) as writer:
+        for f in rendered[:FRAMES]:
+            writer.write_frame({c.name: raw_depth_from_metres(f.depth[c.name], c) for c in scenario.cameras})
+    return path
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_convert_with_the_floor_found_then_track_equals_tracking_with_the_floor(rec, tmp_path):
+    converted = tmp_path / "converted"
+    result = invoke("convert", rec, converted, "--find-floor")
+    assert result.exit_code == 0, result.output
+    assert "m above the floor, tilted" in result.output and "found from the floor" in result.output
+    header = json.loads((converted / "recording.json").read_text())
+    truth = Recording(rec).cameras[0]
+    placed = header["origin"]["cameras"][0]
+    assert header["origin"]["reader"] == "folder" and placed["pose"] == "floor"
+    assert placed["height_m"] == pytest.approx(truth.position[2], abs=0.02)
+    assert placed["tilt_deg"] == pytest.approx(np.degrees(truth.down_angle), abs=1.0)
+    copy = Recording(converted)
+    for a, b in zip(Recording(rec).frames(), copy.frames()):
+        np.testing.assert_array_equal(a.depth[truth.name], b.depth[truth.name])
+    direct, via = tmp_path / "direct", tmp_path / "via"
+    assert invoke("track", rec, "--out", direct, "--find-floor", *FAST).exit_code == 0
+    assert invoke("track", converted, "--out", via, *FAST).exit_code == 0
+    assert (direct / "tracks.csv").read_bytes() == (via / "tracks.csv").read_bytes()
+    cameras = json.loads((direct / "summary.json").read_text())["cameras"]
+    assert cameras == [placed]
+    assert json.loads((via / "summary.json").read_text())["cameras"][0]["pose"] == "recording"
+
+
+def test_a_pose_given_for_a_recording_that_has_one_is_refused(rec, tmp_path):
+    result = invoke("track", rec, "--out", tmp_path / "run", "--camera-height", "1.5", "--tilt", "10")
+    assert result.exit_code == 1 and "has its own world pose; drop the pose option" in result.output
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--camera-height", "1.5"], "--camera-height and --tilt go together"),
+    (["--tilt", "20"], "--camera-height and --tilt go together"),
+    (["--camera-height", "0"], "Invalid value for '--camera-height'"),
+    (["--tilt", "91"], "Invalid value for '--tilt'"),
+    (["--reader", "mp3"], "Invalid value for '--reader'"),
+])
+def test_bad_pose_options(rec, tmp_path, args, message):
+    result = invoke("convert", rec, tmp_path / "out", *args)
+    assert result.exit_code != 0 and message in result.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_world_from_camera_file_with_find_floor_is_refused(rec, tmp_path):
+    pose = tmp_path / "pose.json"
+    pose.write_text(json.dumps({"world_from_camera": HeightTilt(1.0, 0.0).world_from_camera().tolist()}))
+    result = invoke("convert", rec, tmp_path / "out", "--world-from-camera", pose, "--find-floor")
+    assert result.exit_code == 1 and "either a pose or find_floor, not both" in result.output
+
+
+def test_show_and_score_take_the_source_options(rec, tmp_path):
+    result = invoke("show", rec, "--out", tmp_path / "frame.png", "--find-floor", "--frame", "3")
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "frame.png").stat().st_size > 1000
+    tracks = tmp_path / "tracks.csv"
+    tracks.write_text("frame,track,joint,x,y,z,visible\n")
+    result = invoke("score", rec, tracks, "--find-floor", "--unmarked")
+    assert result.exit_code == 1 and "nothing to score against" in result.output
