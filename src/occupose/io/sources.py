@@ -366,3 +366,6 @@ def _open_folder(path: Path, **options):
 
 register_reader(Reader("folder", "occupose's recording folder (recording.json, <camera>/depth/*.png)", None,
                        _is_folder_recording, _open_folder))
+register_reader(Reader("bag", "a ROS 1 .bag (RealSense .bag too) or a ROS 2 bag (a folder with metadata.yaml, "
+                       ".db3 or .mcap): one depth image topic", "ros", lazy("occupose.io.rosbag", "is_bag"),
+                       lazy("occupose.io.rosbag", "open_bag")))
