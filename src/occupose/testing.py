@@ -12,7 +12,9 @@ stage against it (foreground from the grid, track -> person by pixel overlap).
 - :func:`person_observations` and :data:`UPPER_BODY_PARTS`: one person's likelihood
   observations taken from the renderer's labels (stage 3 without stages 1-2);
 - :func:`folder_snapshot`: every entry under a folder, to tell that a command changed
-  nothing there.
+  nothing there;
+- :func:`write_depth_bag`, :func:`write_bag`, :func:`image_message`,
+  :func:`camera_info_message`: ROS 1 / ROS 2 bags of depth images written with rosbags.
 """
 
 from __future__ import annotations
@@ -175,3 +177,107 @@ def folder_snapshot(folder: str | os.PathLike) -> dict[str, str]:
             else:
                 entries[key] = hashlib.sha256(path.read_bytes()).hexdigest()
     return entries
+
+
+#: The RealSense stream info message (librealsense's ``realsense_msgs/StreamInfo``), for
+#: :func:`write_depth_bag`'s RealSense layout.
+STREAM_INFO_MSG = "uint32 fps\nstring encoding\nbool is_recommended\n"
+
+
+def bag_typestore(ros: int):
+    """The rosbags typestore for writing a ROS ``ros`` (1 or 2) bag, with RealSense's StreamInfo."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
+    store.register(get_types_from_msg(STREAM_INFO_MSG, "realsense_msgs/msg/StreamInfo"))
+    return store
+
+
+def _header(store, stamp: float | int, frame_id: str):
+    """A header stamped ``stamp``: seconds (float) or nanoseconds (int)."""
+    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
+    ns = stamp if isinstance(stamp, (int, np.integer)) else int(round(stamp * 1e9))
+    time = Time(sec=int(ns // 10**9), nanosec=int(ns % 10**9))
+    if "seq" in Header.__dataclass_fields__:  # ROS 1
+        return Header(seq=0, stamp=time, frame_id=frame_id)
+    return Header(stamp=time, frame_id=frame_id)
+
+
+def image_message(store, pixels: np.ndarray, encoding: str, stamp: float, *, frame_id: str = "depth",
+                  bigendian: bool = False, padding: int = 0):
+    """A ``sensor_msgs/Image`` of ``pixels`` ((H, W) or (H, W, C) array whose dtype suits
+    ``encoding``), stamped ``stamp`` (float seconds or int nanoseconds), samples big-endian if ``bigendian``, each row
+    followed by ``padding`` bytes of 0xAB."""
+    pixels = np.ascontiguousarray(pixels)
+    if bigendian:
+        pixels = pixels.astype(pixels.dtype.newbyteorder(">"))
+    rows = pixels.reshape(pixels.shape[0], -1).view(np.uint8)
+    data = np.concatenate([rows, np.full((rows.shape[0], padding), 0xAB, np.uint8)], axis=1)
+    return store.types["sensor_msgs/msg/Image"](
+        header=_header(store, stamp, frame_id), height=pixels.shape[0], width=pixels.shape[1], encoding=encoding,
+        is_bigendian=int(bigendian), step=data.shape[1], data=data.ravel())
+
+
+def camera_info_message(store, camera: Camera, *, frame_id: str = "depth"):
+    """A ``sensor_msgs/CameraInfo`` with ``camera``'s size and intrinsics (no distortion)."""
+    Info = store.types["sensor_msgs/msg/CameraInfo"]
+    k = np.array([camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0])
+    p = np.array([camera.fx, 0.0, camera.cx, 0.0, 0.0, camera.fy, camera.cy, 0.0, 0.0, 0.0, 1.0, 0.0])
+    matrices = dict(D=np.zeros(5), K=k, R=np.eye(3).ravel(), P=p)
+    if "k" in Info.__dataclass_fields__:  # ROS 2 names them in lower case
+        matrices = {name.lower(): value for name, value in matrices.items()}
+    Roi = store.types["sensor_msgs/msg/RegionOfInterest"]
+    return Info(header=_header(store, 0.0, frame_id), height=camera.height, width=camera.width,
+                distortion_model="plumb_bob", **matrices, binning_x=0, binning_y=0,
+                roi=Roi(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False))
+
+
+def write_bag(path: str | os.PathLike, messages, store, *, ros: int = 1, storage: str = "sqlite3") -> Path:
+    """Write ``messages`` (an iterable of (topic, msgtype, log time in ns, message), in time
+    order) to a ROS 1 ``.bag`` (``ros`` 1) or a ROS 2 bag folder (``ros`` 2, ``storage``
+    ``sqlite3`` or ``mcap``), uncompressed, with rosbags' writers; returns ``path``."""
+    from rosbags import rosbag1, rosbag2
+
+    path = Path(path)
+    if ros == 1:
+        writer, serialize = rosbag1.Writer(path), store.serialize_ros1
+    else:
+        plugin = {"sqlite3": rosbag2.StoragePlugin.SQLITE3, "mcap": rosbag2.StoragePlugin.MCAP}[storage]
+        writer, serialize = rosbag2.Writer(path, version=9, storage_plugin=plugin), store.serialize_cdr
+    connections = {}
+    with writer:
+        for topic, msgtype, time, message in messages:
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=store)
+            writer.write(connections[topic], time, serialize(message, msgtype))
+    return path
+
+
+def write_depth_bag(path: str | os.PathLike, depths, camera: Camera, *, ros: int = 1, storage: str = "sqlite3",
+                    encoding: str = "16UC1", fps: float = 30.0, start: float = 100.0, realsense: bool = False,
+                    bigendian: bool = False, padding: int = 0) -> Path:
+    """A bag of the depth images ``depths`` (an iterable of (H, W) uint16 raw units, or
+    float32 metres for ``32FC1``), stamped ``start + index / fps`` seconds, with the
+    CameraInfo of ``camera``, in the common ROS layout (``/camera/depth/image_raw``,
+    ``/camera/depth/camera_info``) or, with ``realsense``, in a RealSense recorder's
+    (``/file_version``, ``/device_0/sensor_0/Depth_0/...``, its stream info with ``fps`` and
+    the ``Depth Units`` option set to ``camera.depth_scale``). See :func:`write_bag`."""
+    store = bag_typestore(ros)
+    ns = "/device_0/sensor_0/Depth_0" if realsense else "/camera/depth"
+    topic, info = (f"{ns}/image/data", f"{ns}/info/camera_info") if realsense else (f"{ns}/image_raw", f"{ns}/camera_info")
+    first = int(round(start * 1e9))  # stamps in integer ns: exact at any epoch
+
+    def messages():
+        if realsense:
+            yield "/file_version", "std_msgs/msg/UInt32", first, store.types["std_msgs/msg/UInt32"](data=3)
+            yield f"{ns}/info", "realsense_msgs/msg/StreamInfo", first, store.types["realsense_msgs/msg/StreamInfo"](
+                fps=int(fps), encoding=encoding, is_recommended=True)
+            yield ("/device_0/sensor_0/option/Depth Units/value", "std_msgs/msg/Float32", first,
+                   store.types["std_msgs/msg/Float32"](data=camera.depth_scale))
+        yield info, "sensor_msgs/msg/CameraInfo", first, camera_info_message(store, camera)
+        for index, depth in enumerate(depths):
+            stamp = first + int(round(index * 1e9 / fps))
+            yield topic, "sensor_msgs/msg/Image", stamp, image_message(
+                store, depth, encoding, stamp, bigendian=bigendian, padding=padding)
+
+    return write_bag(path, messages(), store, ros=ros, storage=storage)

@@ -17,8 +17,9 @@ What is read, and from where:
   tree among those that fit it (the same size and ``frame_id``; ``K`` in ROS 1, ``k`` in
   ROS 2; lens distortion is not used); none is an error.
 - time: the image header's stamp (the bag's receive time where the stamp is zero).
-- fps: a RealSense stream's ``<stream>/info`` (``realsense_msgs/StreamInfo``), else the
-  median interval of the first stamps (:data:`DEFAULT_FPS` for a single frame).
+- fps: a RealSense stream's ``<stream>/info`` (``realsense_msgs/StreamInfo``), else one over
+  the median interval of the first :data:`FPS_FRAMES` stamps, to 3 decimals
+  (:data:`DEFAULT_FPS` for a single frame).
 - colour: none. A RealSense bag's ``Color_0`` stream is a different sensor with its own
   intrinsics and pose, not registered to the depth, and an ordinary bag does not say
   whether an RGB topic is registered to its depth, so no colour is read from bags.
@@ -249,7 +250,7 @@ class BagSource(StreamSource):
         intervals = [b - a for a, b in zip(stamps, stamps[1:]) if b > a]
         if not intervals:
             return DEFAULT_FPS
-        return 1.0 / statistics.median(intervals)
+        return round(1.0 / statistics.median(intervals), 3)  # stamps in ns: 30 fps, not 29.99999997
 
     def _depth_units(self, reader, topics: dict[str, str]) -> float:
         units = _nearest(self.topic, [t for t in topics if t.endswith("/" + DEPTH_UNITS)])
