@@ -12,6 +12,7 @@ from occupose._numba import configure
 configure()  # before any benchmark imports numba
 
 from benchmarks import (  # noqa: E402
+    bench_bag,
     bench_blobs,
     bench_body,
     bench_filters,
@@ -26,7 +27,7 @@ from benchmarks import (  # noqa: E402
 )
 
 BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages,
-              bench_robustness]
+              bench_robustness, bench_bag]
 
 
 def machine() -> str:
