@@ -263,8 +263,11 @@ def write_depth_bag(path: str | os.PathLike, depths, camera: Camera, *, ros: int
     (``/file_version``, ``/device_0/sensor_0/Depth_0/...``, its stream info with ``fps`` and
     the ``Depth Units`` option set to ``camera.depth_scale``). See :func:`write_bag`."""
     store = bag_typestore(ros)
-    ns = "/device_0/sensor_0/Depth_0" if realsense else "/camera/depth"
-    topic, info = (f"{ns}/image/data", f"{ns}/info/camera_info") if realsense else (f"{ns}/image_raw", f"{ns}/camera_info")
+    if realsense:
+        ns = "/device_0/sensor_0/Depth_0"
+        topic, info = f"{ns}/image/data", f"{ns}/info/camera_info"
+    else:
+        topic, info = "/camera/depth/image_raw", "/camera/depth/camera_info"
     first = int(round(start * 1e9))  # stamps in integer ns: exact at any epoch
 
     def messages():

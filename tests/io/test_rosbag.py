@@ -193,7 +193,8 @@ def test_bad_bags_are_source_errors_naming_the_file(tmp_path):
 def test_missing_rosbags_names_the_extra(tmp_path, monkeypatch):
     path = write_depth_bag(tmp_path / "rec.bag", raw_depths(1), CAMERA)
     monkeypatch.setitem(sys.modules, "rosbags", None)  # as if it were not installed
-    with pytest.raises(ImportError, match=r"reading ROS bags needs the 'rosbags' package .*pip install 'occupose\[ros\]'"):
+    with pytest.raises(ImportError, match=r"reading ROS bags needs the 'rosbags' package .*"
+                                          r"pip install 'occupose\[ros\]'"):
         open_source(path, pose=POSE)
 
 
