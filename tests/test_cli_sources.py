@@ -89,3 +89,43 @@ def test_show_and_score_take_the_source_options(rec, tmp_path):
     tracks.write_text("frame,track,joint,x,y,z,visible\n")
     result = invoke("score", rec, tracks, "--find-floor", "--unmarked")
     assert result.exit_code == 1 and "nothing to score against" in result.output
+
+
+def test_export_in_the_camera_frame_uses_the_pose_the_run_found(rec, tmp_path):
+    """A run that placed the camera from the floor writes its pose into summary.json, and
+    export's camera frame is that pose's, not the recording's own: the exported JSON holds
+    the run's (to the 0.1 mm tracks.csv keeps; with the recording's own pose joints move by
+    centimetres)."""
+    run = tmp_path / "run"
+    result = invoke("track", rec, "--out", run, "--find-floor", "--format", "json", "--frame", "camera", *FAST)
+    assert result.exit_code == 0, result.output
+    entry, = json.loads((run / "summary.json").read_text())["cameras"]
+    pose = np.array(entry["world_from_camera"])
+    own = Recording(rec).cameras[0].world_from_camera
+    assert entry["pose"] == "floor" and pose[2, 3] == pytest.approx(entry["height_m"], abs=1e-4)
+    assert np.abs(pose - own).max() > 1e-3  # the found world differs from the recording's a little
+    exported = tmp_path / "exported.json"
+    result = invoke("export", run / "tracks.csv", "--to", "json", "--frame", "camera", "--out", exported)
+    assert result.exit_code == 0, result.output
+    ran, again = (json.loads(path.read_text())["frames"] for path in (run / "tracks.json", exported))
+    assert [f["frame_id"] for f in ran] == [f["frame_id"] for f in again] and len(ran) == FRAMES
+    points = [np.array([[[np.nan] * 3 if j is None else j for j in b["joint_positions"]] for b in f["bodies"]],
+                       dtype=float).reshape(-1, 3) for f in (*ran, *again)]
+    assert sum(np.isfinite(p).all(axis=1).sum() for p in points[:FRAMES]) >= FRAMES // 2 * 15
+    for a, b in zip(points[:FRAMES], points[FRAMES:]):
+        np.testing.assert_allclose(a, b, atol=0.1)  # mm; NaN where both have no joint
+
+
+def test_export_in_the_camera_frame_of_a_recording_without_a_pose_needs_the_runs(rec, tmp_path):
+    from occupose.io.joint_table import write_tracks_csv
+    from occupose.testing import write_depth_bag
+
+    recording = Recording(rec)
+    camera = recording.cameras[0]
+    bag = write_depth_bag(tmp_path / "rec.bag", (raw_depth_from_metres(f.depth[camera.name], camera)
+                                                 for f in recording.frames()), camera, fps=recording.fps)
+    tracks = write_tracks_csv(tmp_path / "tracks.csv", {})  # a run's, its summary.json lost
+    result = invoke("export", tracks, "--recording", bag, "--to", "json", "--frame", "camera",
+                    "--out", tmp_path / "x.json")
+    assert result.exit_code == 1 and "its camera frame is unknown; export in the world frame" in result.output
+    assert not (tmp_path / "x.json").exists()

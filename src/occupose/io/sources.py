@@ -311,7 +311,8 @@ def place_from_floor(source: StreamSource, config=None) -> StreamSource:
 def placement(source: FrameSource) -> list[dict[str, Any]]:
     """Each camera's pose as a user reads it: ``name``, ``height_m`` (above the floor z = 0),
     ``tilt_deg`` (the optical axis below the horizontal), ``roll_deg`` and ``pose`` (where
-    it came from: ``recording``, ``given`` or ``floor``)."""
+    it came from: ``recording``, ``given`` or ``floor``) and ``world_from_camera`` (the (4, 4)
+    pose as nested lists, so that a run's camera frame can be rebuilt from its summary)."""
     origin = getattr(source, "pose_from", "recording")
     entries = []
     for camera in source.cameras:
@@ -319,7 +320,7 @@ def placement(source: FrameSource) -> list[dict[str, Any]]:
         entries.append({"name": camera.name, "height_m": round(float(pose[2, 3]), 4),
                         "tilt_deg": round(math.degrees(math.asin(np.clip(-pose[2, 2], -1, 1))), 3),
                         "roll_deg": round(math.degrees(math.asin(np.clip(pose[2, 0], -1, 1))), 3),
-                        "pose": origin})
+                        "pose": origin, "world_from_camera": pose.tolist()})
     return entries
 
 
