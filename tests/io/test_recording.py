@@ -462,3 +462,61 @@ def test_colour_is_left_undecoded_when_not_asked_for(rec):
 def test_frame_files_past_num_frames_are_refused(rec):
     (rec / "top" / "depth" / "000003.png").write_bytes((rec / "top" / "depth" / "000002.png").read_bytes())
     expect_error(rec, rec / "top" / "depth", r"1 frame file\(s\) past the recording's \"num_frames\" 3 \(000003.png\)")
+
+
+def _write_timed(path, rng, times):
+    cameras, depths, _, _, _ = make_data(rng)
+    with RecordingWriter(path, cameras, fps=30.0) as writer:
+        for depth, time in zip(depths, times):
+            writer.write_frame(depth, time=time)
+    return path
+
+
+def test_uneven_frame_times_round_trip_through_times_csv(tmp_path, rng):
+    times = [0.0, 1 / 30, 3 / 30 + 0.0012]  # frame 2 of the camera was dropped
+    path = _write_timed(tmp_path / "rec", rng, times)
+    assert (path / "times.csv").read_text() == "frame,time\n0,0.000000\n1,0.033333\n2,0.101200\n"
+    assert [f.time for f in Recording(path).frames(color=False)] == pytest.approx(times, abs=1e-6)
+
+
+def test_even_frame_times_write_no_times_csv(tmp_path, rng):
+    path = _write_timed(tmp_path / "rec", rng, [i / 30 + 1e-7 for i in range(NUM_FRAMES)])
+    assert not (path / "times.csv").exists()
+    assert [f.time for f in Recording(path).frames(color=False)] == [i / 30 for i in range(NUM_FRAMES)]
+
+
+def test_writer_rejects_bad_times(tmp_path, rng):
+    cameras, depths, _, _, _ = make_data(rng)
+    for k, (times, message) in enumerate([([0.0, None], "for every frame or for none"),
+                                          ([None, 0.1], "for every frame or for none"),
+                                          ([0.0, -0.1], "not before the previous"),
+                                          ([float("nan")], "must be finite")]):
+        writer = RecordingWriter(tmp_path / f"r{k}", cameras, fps=30.0)
+        with pytest.raises(ValueError, match=message):
+            for depth, time in zip(depths, times):
+                writer.write_frame(depth, time=time)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("time,frame\n", "first line must be 'frame,time'"),
+    ("frame,time\n0,0\n1,0.1\n", "2 frame time\\(s\\), the recording has 3"),
+    ("frame,time\n0,0\n2,0.1\n1,0.2\n", "line 3 must be '1,<seconds>'"),
+    ("frame,time\n0,0\n1,x\n2,0.2\n", "line 3 must be '1,<seconds>'"),
+    ("frame,time\n0,0\n1,0.2\n2,0.1\n", "line 4: frame 2's time '0.1' is not finite or is before"),
+    ("frame,time\n0,0\n1,inf\n2,0.1\n", "not finite"),
+])
+def test_bad_times_csv(tmp_path, rng, text, message):
+    path = _write_timed(tmp_path / "rec", rng, [0.0, 0.05, 0.1])
+    (path / "times.csv").write_text(text)
+    with pytest.raises(RecordingError, match=message):
+        Recording(path)
+
+
+def test_convert_keeps_uneven_frame_times(tmp_path, rng):
+    from occupose.io.convert import convert
+
+    times = [0.0, 0.05, 0.2]
+    source = Recording(_write_timed(tmp_path / "rec", rng, times))
+    copy = Recording(convert(source, tmp_path / "copy"))
+    assert (tmp_path / "copy" / "times.csv").read_bytes() == (tmp_path / "rec" / "times.csv").read_bytes()
+    assert [f.time for f in copy.frames(color=False)] == times

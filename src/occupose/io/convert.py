@@ -3,7 +3,8 @@
 The folder holds every frame's depth (and colour where the source has it, registered to
 the depth) in the source's own raw units, the cameras as placed (the world pose the
 recording had, was given or was found from the floor), and in ``recording.json``'s
-``origin`` where it came from and each camera's height, tilt and roll.
+``origin`` where it came from and each camera's height, tilt and roll, and the frames'
+times in ``times.csv`` where they are not evenly spaced at the fps (dropped frames).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ def convert(source: FrameSource, out: str | os.PathLike, *, reader: str | None =
         with RecordingWriter(folder, source.cameras, source.fps, origin=origin) as writer:
             for frame in source.frames(color=color):
                 writer.write_frame({c.name: raw_depth_from_metres(frame.depth[c.name], c) for c in source.cameras},
-                                   frame.color or None)
+                                   frame.color or None, time=frame.time)
                 if progress is not None:
                     progress(1)
     return Path(out)

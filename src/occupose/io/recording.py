@@ -7,10 +7,13 @@
       <camera>/depth/000000.png    16-bit PNG; depth = value * depth_scale metres; 0 = no measurement
       <camera>/color/000000.png    optional 8-bit RGB, registered to the depth image
       groundtruth.csv              optional: frame,person,joint,x,y,z[,visible] (world metres)
+      times.csv                    optional: frame,time (seconds since the first frame)
 
 A camera has colour when its ``color`` folder exists; it then has a colour image for
 every frame. Ground truth has one row per frame, person and known joint; joints with
-no row are unknown (NaN); `occupose.io.joint_table` reads and writes it.
+no row are unknown (NaN); `occupose.io.joint_table` reads and writes it. ``times.csv``
+holds each frame's time where the frames were not evenly spaced at ``fps`` (a converted
+recording whose device dropped frames); without it frame i is at i / fps.
 
 Opening a recording checks ``recording.json`` and every frame file's PNG header (mode and
 size; no image is decoded before its header is checked), and refuses frame files past
@@ -50,6 +53,10 @@ OPTIONAL_KEYS: tuple[str, ...] = ("origin",)
 
 _JSON_NAME = "recording.json"
 _GROUNDTRUTH_NAME = "groundtruth.csv"
+_TIMES_NAME = "times.csv"
+#: Seconds by which a frame's time may differ from index / fps before times.csv is written;
+#: times.csv keeps microseconds.
+_TIME_TOLERANCE_S = 1e-6
 
 
 #: Synthetic label images a recording may carry beside depth and colour.
@@ -133,6 +140,7 @@ class RecordingWriter:
         self.num_frames = 0
         self._color_names: frozenset[str] | None = None
         self._groundtruth_frames: int | None = None
+        self._times: list[float] = []
         self._closed = False
         for camera in cameras:
             (self.path / camera.name / "depth").mkdir(parents=True, exist_ok=True)
@@ -153,6 +161,7 @@ class RecordingWriter:
         depths: Mapping[str, np.ndarray],
         colors: Mapping[str, np.ndarray] | None = None,
         labels: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+        time: float | None = None,
     ) -> None:
         """Append one frame.
 
@@ -160,8 +169,17 @@ class RecordingWriter:
         colors : dict camera name -> (H, W, 3) uint8 RGB, or None for no colour
         labels : optional synthetic label images, dict camera name -> {kind: (H, W) uint8}
             with kind in LABEL_KINDS ("person": person id, 0 = none; "part": body-part label)
+        time : seconds since the first frame (given for every frame or for none; not
+            decreasing); times that are not index / fps are written into times.csv
         """
         self._check_open()
+        if (time is None) != (not self._times) and self.num_frames:
+            raise ValueError(f"time must be given for every frame or for none (frame {self.num_frames})")
+        if time is not None:
+            time = float(time)
+            if not np.isfinite(time) or (self._times and time < self._times[-1]):
+                raise ValueError(f"frame {self.num_frames}'s time must be finite and not before the previous "
+                                 f"frame's, got {time!r}")
         colors = {} if colors is None else dict(colors)
         labels = {} if labels is None else dict(labels)
         expected = [c.name for c in self.cameras]
@@ -208,6 +226,8 @@ class RecordingWriter:
                 folder.mkdir(exist_ok=True)
             Image.fromarray(image).save(folder / name, compress_level=1)
         self._color_names = frozenset(colors)
+        if time is not None:
+            self._times.append(time)
         self.num_frames += 1
 
     def write_groundtruth(
@@ -237,7 +257,8 @@ class RecordingWriter:
         self._groundtruth_frames = joints.shape[0]
 
     def close(self) -> None:
-        """Write ``recording.json``. Calling it again does nothing."""
+        """Write ``recording.json`` (and ``times.csv`` when a frame's time is not its
+        index / fps). Calling it again does nothing."""
         if self._closed:
             return
         if self._groundtruth_frames is not None and self._groundtruth_frames != self.num_frames:
@@ -245,6 +266,10 @@ class RecordingWriter:
                 f"{self.path / _GROUNDTRUTH_NAME}: ground truth has {self._groundtruth_frames} frames, "
                 f"the recording {self.num_frames}"
             )
+        even = np.arange(self.num_frames) / self.fps
+        if self._times and np.abs(np.asarray(self._times) - even).max() > _TIME_TOLERANCE_S:
+            rows = "".join(f"{i},{t:.6f}\n" for i, t in enumerate(self._times))
+            write_text(self.path / _TIMES_NAME, "frame,time\n" + rows)
         # one camera per line, as in DESIGN.md, rather than one number per line
         head = {"format": FORMAT, "version": VERSION, "fps": self.fps, "num_frames": self.num_frames}
         head = json.dumps(head if self.origin is None else dict(head, origin=self.origin))
@@ -377,13 +402,43 @@ def _read_png(file: Path, kind: str, camera: Camera, *, decode: bool = True) -> 
         raise RecordingError(f"{file}: not a readable PNG image ({error})") from None
 
 
+def _read_times(file: Path, num_frames: int) -> np.ndarray | None:
+    """(num_frames,) float64 seconds of ``times.csv`` (a ``frame,time`` header, then frames
+    0 .. num_frames - 1 in order, times finite and not decreasing), or None without one."""
+    if not file.exists():
+        return None
+    try:
+        text = read_file_bytes(file, RecordingError, "the frames' times").decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        raise RecordingError(f"{file}: not a UTF-8 text file ({error.reason})") from None
+    lines = text.splitlines()
+    if not lines or lines[0].strip() != "frame,time":
+        raise RecordingError(f"{file}: the first line must be 'frame,time'")
+    rows = lines[1:]
+    if len(rows) != num_frames:
+        raise RecordingError(f"{file}: {len(rows)} frame time(s), the recording has {num_frames} frames")
+    times = np.empty(num_frames)
+    for i, row in enumerate(rows):
+        fields = row.split(",")
+        try:
+            if len(fields) != 2 or int(fields[0]) != i:
+                raise ValueError
+            times[i] = float(fields[1])
+        except ValueError:
+            raise RecordingError(f"{file}: line {i + 2} must be '{i},<seconds>', got {row[:60]!r}") from None
+        if not np.isfinite(times[i]) or (i and times[i] < times[i - 1]):
+            raise RecordingError(f"{file}: line {i + 2}: frame {i}'s time {fields[1]!r} is not finite or is before "
+                                 "the previous frame's")
+    return times
+
+
 class Recording:
     """An open recording folder (read-only; images are read on demand).
 
     Attributes: ``path`` (Path), ``fps`` (float), ``num_frames`` (int), ``cameras``
     (list of Camera). Opening checks ``recording.json``, that every frame file exists and
-    that its PNG header gives the right mode and size (nothing is decoded), and that no
-    camera has frame files past ``num_frames``.
+    that its PNG header gives the right mode and size (nothing is decoded), that no
+    camera has frame files past ``num_frames``, and ``times.csv`` where there is one.
     """
 
     def __init__(self, path: str | os.PathLike):
@@ -391,6 +446,7 @@ class Recording:
         if not self.path.is_dir():
             raise FileNotFoundError(f"{self.path}: no such recording folder")
         self.fps, self.num_frames, self.cameras = _read_header(self.path / _JSON_NAME)
+        self._times = _read_times(self.path / _TIMES_NAME, self.num_frames)
         self._by_name = {c.name: c for c in self.cameras}
         self._color_names = []
         for camera in self.cameras:
@@ -466,7 +522,8 @@ class Recording:
             c.name: (self.depth_raw(index, c.name) * c.depth_scale).astype(np.float32) for c in self.cameras
         }
         colors = {name: self.color(index, name) for name in self._color_names} if color else {}
-        return Frame(index=index, depth=depth, color=colors, time=index / self.fps)
+        time = index / self.fps if self._times is None else float(self._times[index])
+        return Frame(index=index, depth=depth, color=colors, time=time)
 
     def frames(self, *, color: bool = True) -> Iterator[Frame]:
         """Iterate over all frames in order, reading each when it is reached (`frame`)."""
