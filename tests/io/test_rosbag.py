@@ -64,6 +64,12 @@ def test_a_ros2_storage_file_and_a_folder_without_metadata_open(tmp_path, storag
     np.testing.assert_array_equal(raw_frames(open_source(folder, pose=POSE))[0], depths)
 
 
+def test_a_ros2_bag_folder_named_like_a_ros1_file_opens(tmp_path):
+    depths = raw_depths(2, seed=3)
+    folder = write_depth_bag(tmp_path / "rec.bag", depths, CAMERA, ros=2)
+    assert folder.is_dir() and (folder / "metadata.yaml").is_file()
+    np.testing.assert_array_equal(raw_frames(open_source(folder, pose=POSE))[0], depths)
+
 def test_realsense_layout_depth_units_and_stream_fps(tmp_path):
     camera = Camera("cam", 64, 48, 380.5, 380.5, 32.1, 24.2, 0.0001)
     depths = raw_depths(3, camera, seed=2)

@@ -113,8 +113,9 @@ def is_bag(path: Path) -> bool:
 
 def _bag_paths(path: Path) -> list[Path]:
     """What ``AnyReader`` opens for ``path``: the file, the bag folder, or the ``.db3`` /
-    ``.mcap`` files of a folder without ``metadata.yaml``."""
-    if path.is_dir() and not (path / "metadata.yaml").is_file():
+    ``.mcap`` files of a folder without ``metadata.yaml`` or named ``*.bag`` (AnyReader
+    takes any path ending in ``.bag`` for a ROS 1 file)."""
+    if path.is_dir() and (path.suffix.lower() == ".bag" or not (path / "metadata.yaml").is_file()):
         files = sorted(p for s in SUFFIXES[1:] for p in path.glob(f"*{s}"))
         if not files:
             raise SourceError(f"{path}: a folder without metadata.yaml or a .db3 / .mcap file is not a ROS bag")
