@@ -24,7 +24,8 @@ What is read, and from where:
   pose, not registered to the depth; the tracker uses depth only.
 
 Memory stays flat: one packet at a time. Opening the file reads the depth track through
-once to count its frames (at disk speed: the other tracks' blocks are skipped).
+once to count its frames (at disk speed: the other tracks' blocks are skipped). A file cut
+short gives the whole frames before the cut.
 The camera, ``cam0``, has no world pose (``pose_known`` False): :func:`open_source` places
 it from a pose given or the floor (the IMU's gravity helps choose the floor plane).
 """
@@ -329,7 +330,7 @@ class MkvSource(StreamSource):
         self.depth_mode = stream.metadata.get("K4A_DEPTH_MODE") or sizes.get((width, height))
         if self.depth_mode not in DEPTH_MODES or DEPTH_MODES[self.depth_mode][2] != (width, height):
             raise self._fail(f"a {width}x{height} {DEPTH_TITLE} track of depth mode {self.depth_mode!r}: not an "
-                             f"Azure Kinect depth mode ({', '.join(f'{n} {w}x{h}' for n, (w, h) in sizes.items())})")
+                             f"Azure Kinect depth mode ({', '.join(f'{n} {w}x{h}' for (w, h), n in sizes.items())})")
         self.calibration = self._calibration(container)
         try:
             camera = camera_from_calibration(self.calibration, self.depth_mode)
@@ -401,8 +402,9 @@ class MkvSource(StreamSource):
                     if packet.size == 0 or packet.pts is None:
                         continue
                     if packet.size != self._frame_bytes:
-                        raise self._fail(f"a {DEPTH_TITLE} frame of {packet.size} bytes at {self._seconds(packet.pts):.6f}"
-                                         f" s; {camera.width}x{camera.height} 16-bit frames have {self._frame_bytes}")
+                        raise self._fail(f"a {DEPTH_TITLE} frame of {packet.size} bytes at "
+                                         f"{self._seconds(packet.pts):.6f} s; {camera.width}x{camera.height} "
+                                         f"16-bit frames have {self._frame_bytes}")
                     depth = np.frombuffer(packet, ">u2").astype(np.uint16).reshape(camera.height, camera.width)
                     yield {camera.name: depth}, {}, self._seconds(packet.pts)
         except SourceError:
