@@ -402,3 +402,27 @@ def write_depth_mkv(path: str | os.PathLike, depths, camera: Camera, *, mode: st
             out.mux(packet)
     _set_vfw_compression(path, title.encode(), b"b16g")
     return path
+
+
+# ------------------------------------------------------------------------- TUM RGB-D folders
+
+def write_tum_folder(path: str | os.PathLike, depths, *, fps: float = 30.0, start: float = 1305031102.175304,
+                     stamps=None) -> Path:
+    """A TUM RGB-D folder of the depth images ``depths`` ((H, W) uint16, metres * 5000 each):
+    ``depth/<timestamp>.png`` (16-bit grayscale) and ``depth.txt`` listing them with the
+    dataset's three comment lines, stamped ``stamps`` or ``start + index / fps`` seconds
+    (6 decimals, as the dataset writes them); returns ``path``."""
+    from PIL import Image
+
+    path = Path(path)
+    (path / "depth").mkdir(parents=True, exist_ok=True)
+    lines = ["# depth maps", f"# file: '{path.name}.bag'", "# timestamp filename"]
+    for index, depth in enumerate(depths):
+        depth = np.asarray(depth)
+        if depth.dtype != np.uint16 or depth.ndim != 2:
+            raise ValueError(f"depth image {index} is {depth.dtype} {depth.shape}, expected (H, W) uint16")
+        stamp = f"{(start + index / fps) if stamps is None else stamps[index]:.6f}"
+        Image.fromarray(depth).save(path / "depth" / f"{stamp}.png")
+        lines.append(f"{stamp} depth/{stamp}.png")
+    (path / "depth.txt").write_text("\n".join(lines) + "\n")
+    return path

@@ -413,6 +413,9 @@ class MkvSource(StreamSource):
             raise self._fail(f"the {DEPTH_TITLE} track could not be read ({type(error).__name__}: {error})") from None
 
 
-def open_mkv(path: Path) -> MkvSource:
-    """The Azure Kinect recording at ``path`` as a frame source (:class:`MkvSource`)."""
+def open_mkv(path: Path, **options) -> MkvSource:
+    """The Azure Kinect recording at ``path`` as a frame source (:class:`MkvSource`); it
+    takes no reader options (SourceError naming any given)."""
+    if options:
+        raise SourceError(f"{path}: an Azure Kinect .mkv takes no reader options, got {sorted(options)}")
     return MkvSource(Path(path))
