@@ -12,8 +12,9 @@ pytest.importorskip("av")
 from occupose.camera import Camera, raw_depth_from_metres  # noqa: E402
 from occupose.io.mkv import (DEPTH_MODES, MkvSource, camera_from_calibration,  # noqa: E402
                              gravity_from_accelerations, imu_samples)
-from occupose.io.recording import Recording, RecordingWriter  # noqa: E402
-from occupose.io.sources import HeightTilt, NoWorldPoseError, SourceError, open_source, reader_for  # noqa: E402
+from occupose.io.recording import RecordingWriter  # noqa: E402
+from occupose.io.sources import (HeightTilt, NoWorldPoseError, SourceError, open_source, placement,  # noqa: E402
+                                 reader_for)
 from occupose.paths import shared_data_dir  # noqa: E402
 from occupose.testing import AZURE_ACCEL_ROTATION, azure_calibration, write_depth_mkv  # noqa: E402
 
@@ -178,35 +179,42 @@ def test_reading_streams_with_flat_memory(tmp_path):
     assert index == 119 and peak < 3e6, f"peak {peak / 1e6:.1f} MB while reading 22 MB of frames"
 
 
-def _folder_and(tmp_path, rendered, camera, fps):
-    with RecordingWriter(tmp_path / "rec", [camera], fps=fps) as writer:
-        for frame in rendered:
-            writer.write_frame({camera.name: raw_depth_from_metres(frame.depth[camera.name], camera)})
-    return Recording(tmp_path / "rec")
-
-
 def test_an_mkv_tracks_as_the_folder_it_was_made_from(tmp_path):
-    from occupose.run import track_recording
+    """``occupose track`` on an .mkv made from a synthetic recording (with an IMU track that
+    agrees with the true pose) gives the folder's tracks.csv, with the pose given and with
+    the pose found from the floor (the folder with --find-floor)."""
+    from click.testing import CliRunner
+
+    from occupose.cli import main
     from occupose.synth.generate import frames
     from occupose.synth.scenarios import build_scenario
 
     scenario = build_scenario("no_occlusion", sensor="azure_nfov", use_mocap=False)  # 640 x 576, NFOV unbinned
     camera = scenario.cameras[0]
-    rendered = list(frames(scenario, seed=0, num_frames=20))
-    folder = _folder_and(tmp_path, rendered, camera, scenario.fps)
-    mkv = write_depth_mkv(tmp_path / "rec.mkv", (raw_depth_from_metres(f.depth[camera.name], camera)
-                                                 for f in rendered), camera, fps=scenario.fps)
+    raw = [raw_depth_from_metres(f.depth[camera.name], camera) for f in frames(scenario, seed=0, num_frames=20)]
+    with RecordingWriter(tmp_path / "rec", [camera], fps=scenario.fps) as writer:
+        for image in raw:
+            writer.write_frame({camera.name: image})
+    up = camera.world_from_camera[:3, :3].T @ [0.0, 0.0, 1.0]  # world up in the camera frame
+    accelerations = np.tile(np.array(AZURE_ACCEL_ROTATION) @ (9.81 * up), (200, 1))
+    mkv = write_depth_mkv(tmp_path / "rec.mkv", raw, camera, fps=scenario.fps, accelerations=accelerations)
     (tmp_path / "pose.json").write_text(json.dumps({"world_from_camera": camera.world_from_camera.tolist()}))
-    source = open_source(mkv, pose=tmp_path / "pose.json")
-    from_mkv, from_folder = track_recording(source, seed=0), track_recording(folder, seed=0)
-    assert from_mkv.num_frames == 20 and list(from_mkv.tracks) == list(from_folder.tracks) != []
-    for track, (joints, visible) in from_folder.tracks.items():
-        np.testing.assert_array_equal(from_mkv.tracks[track][0], joints)
-        np.testing.assert_array_equal(from_mkv.tracks[track][1], visible)
-    # and placed from the floor in its frames, as the folder is with --find-floor
-    floor_mkv, floor_folder = open_source(mkv), open_source(folder.path, find_floor=True)
-    np.testing.assert_allclose(floor_mkv.cameras[0].world_from_camera, floor_folder.cameras[0].world_from_camera)
-    assert abs(floor_mkv.cameras[0].world_from_camera[2, 3] - camera.world_from_camera[2, 3]) < 0.02
+
+    def track(*args):
+        out = tmp_path / f"run{len(list(tmp_path.glob('run*')))}"
+        result = CliRunner().invoke(main, ["track", *map(str, args), "--out", str(out)])
+        assert result.exit_code == 0, result.output
+        return (out / "tracks.csv").read_text()
+
+    given = track(mkv, "--world-from-camera", tmp_path / "pose.json")
+    assert given == track(tmp_path / "rec") and given.count("\n") > 20
+    assert track(mkv) == track(tmp_path / "rec", "--find-floor")
+    # the floor estimate with the IMU's gravity: the true height and tilt
+    source = open_source(mkv)
+    np.testing.assert_allclose(source.gravity["cam0"], -up, atol=1e-6)
+    (placed,) = placement(source)
+    true_tilt = np.degrees(np.arcsin(-camera.world_from_camera[2, 2]))
+    assert abs(placed["height_m"] - camera.world_from_camera[2, 3]) < 0.02 and abs(placed["tilt_deg"] - true_tilt) < 1
 
 
 @pytest.mark.shared

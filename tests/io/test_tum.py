@@ -101,7 +101,8 @@ def test_bad_folders_are_source_errors_naming_the_file(tmp_path):
     with open(sizes / "depth.txt", "a") as listing:
         listing.write(f"2000000000.000000 {(tmp_path / 'sizes_b' / 'depth' / '2000000000.000000.png').resolve()}\n")
     cases = [("missing", {"camera": INTRINSICS}, r"missing/depth.txt: 1 listed file\(s\) missing: depth/"),
-             ("rgb", {"camera": INTRINSICS}, r"\.png: expected a 16-bit grayscale PNG, got a PNG image of mode 'RGB'"),
+             ("rgb", {"camera": INTRINSICS}, r"\.png: expected a 16-bit grayscale PNG, got a PNG image of mode "
+                                             r"'RGB'"),
              ("good", {"camera": "fr9"}, r"unknown TUM camera 'fr9'"),
              ("good", {"topic": "/x"}, r"good: a TUM RGB-D folder takes only the reader option camera, got \['topic'\]")]
     for name, options, message in cases:
@@ -153,4 +154,5 @@ def test_a_tum_folder_tracks_as_the_folder_it_was_made_from(tmp_path, walk):
     assert result.exit_code == 0, result.output
     from_tum = (tmp_path / "run_tum" / "tracks.csv").read_text()
     assert from_tum == (tmp_path / "run_folder" / "tracks.csv").read_text() and from_tum.count("\n") > 20
-    assert Recording(tmp_path / "rec").num_frames == open_source(tum, pose=POSE, camera=tmp_path / "cam.json").num_frames
+    assert Recording(tmp_path / "rec").num_frames == open_source(tum, pose=POSE,
+                                                                 camera=tmp_path / "cam.json").num_frames
