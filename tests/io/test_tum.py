@@ -104,7 +104,8 @@ def test_bad_folders_are_source_errors_naming_the_file(tmp_path):
              ("rgb", {"camera": INTRINSICS}, r"\.png: expected a 16-bit grayscale PNG, got a PNG image of mode "
                                              r"'RGB'"),
              ("good", {"camera": "fr9"}, r"unknown TUM camera 'fr9'"),
-             ("good", {"topic": "/x"}, r"good: a TUM RGB-D folder takes only the reader option camera, got \['topic'\]")]
+             ("good", {"topic": "/x"}, r"good: a TUM RGB-D folder takes only the reader option camera, got "
+                                       r"\['topic'\]")]
     for name, options, message in cases:
         with pytest.raises(SourceError, match=message):
             open_source(tmp_path / name, pose=POSE, **options)
