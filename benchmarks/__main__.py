@@ -18,6 +18,7 @@ from benchmarks import (  # noqa: E402
     bench_filters,
     bench_grid,
     bench_likelihood,
+    bench_mkv,
     bench_render,
     bench_robustness,
     bench_speed,
@@ -27,7 +28,7 @@ from benchmarks import (  # noqa: E402
 )
 
 BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages,
-              bench_robustness, bench_bag]
+              bench_robustness, bench_bag, bench_mkv]
 
 
 def machine() -> str:

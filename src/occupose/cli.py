@@ -135,6 +135,9 @@ def _source_options(command):
         click.option("--reader", type=click.Choice(list(READERS)), default=None,
                      help="The recording's format (default: recognised from the path)."),
         click.option("--topic", default=None, help="ROS bags: the depth image topic (default: the only one)."),
+        click.option("--tum-camera", default=None, metavar="fr1|fr2|fr3|FILE.json",
+                     help="TUM RGB-D folders: the camera's intrinsics, by name or a JSON file of fx, fy, cx, cy "
+                          "(default: from freiburg1/2/3 in the folder's name)."),
         click.option("--camera-height", type=click.FloatRange(min=0, min_open=True), default=None,
                      help="A recording without a world pose: the camera's height above the floor, metres "
                           "(with --tilt; default: found from the floor in its first frames)."),
@@ -152,8 +155,8 @@ def _source_options(command):
     return command
 
 
-def _open(recording: Path, reader=None, topic=None, camera_height=None, tilt=None, pose_file=None,
-          find_floor=False, floor=None):
+def _open(recording: Path, reader=None, topic=None, tum_camera=None, camera_height=None, tilt=None,
+          pose_file=None, find_floor=False, floor=None):
     """The recording at ``recording`` (any format) with its cameras placed (the
     ``_source_options``); a pose found from the floor or given is printed to stderr."""
     from occupose.io.sources import HeightTilt, open_source, placement
@@ -164,6 +167,8 @@ def _open(recording: Path, reader=None, topic=None, camera_height=None, tilt=Non
         _fail("give the pose with either --camera-height and --tilt or --world-from-camera, not both")
     pose = HeightTilt(camera_height, tilt) if camera_height is not None else pose_file
     options = {} if topic is None else {"topic": topic}
+    if tum_camera is not None:
+        options["camera"] = tum_camera
     source = open_source(recording, format=reader, pose=pose, find_floor=find_floor, floor=floor, **options)
     for entry in placement(source):
         if entry["pose"] != "recording":

@@ -14,7 +14,10 @@ stage against it (foreground from the grid, track -> person by pixel overlap).
 - :func:`folder_snapshot`: every entry under a folder, to tell that a command changed
   nothing there;
 - :func:`write_depth_bag`, :func:`write_bag`, :func:`image_message`,
-  :func:`camera_info_message`: ROS 1 / ROS 2 bags of depth images written with rosbags.
+  :func:`camera_info_message`: ROS 1 / ROS 2 bags of depth images written with rosbags;
+- :func:`write_depth_mkv`, :func:`azure_calibration`: Azure Kinect style ``.mkv`` files of
+  depth images written with PyAV;
+- :func:`write_tum_folder`: TUM RGB-D folders of depth images.
 """
 
 from __future__ import annotations
@@ -284,3 +287,142 @@ def write_depth_bag(path: str | os.PathLike, depths, camera: Camera, *, ros: int
                 store, depth, encoding, stamp, bigendian=bigendian, padding=padding)
 
     return write_bag(path, messages(), store, ros=ros, storage=storage)
+
+
+# ------------------------------------------------------------------------- Azure Kinect .mkv
+
+#: The accelerometer extrinsics (``Rt.Rotation``, depth camera to accelerometer) of the
+#: shared Azure Kinect's factory calibration, for :func:`azure_calibration`.
+AZURE_ACCEL_ROTATION = ((0.0019369830843061209, 0.1084766760468483, -0.994097113609314),
+                        (-0.9999940395355225, -0.0026388836558908224, -0.002236430300399661),
+                        (-0.002865907270461321, 0.994095504283905, 0.10847091674804688))
+
+
+def azure_calibration(camera: Camera, mode: str, *, accel_rotation=AZURE_ACCEL_ROTATION) -> dict:
+    """A minimal Azure Kinect ``calibration.json`` (parsed) whose depth camera, taken to
+    depth mode ``mode`` by :func:`occupose.io.mkv.camera_from_calibration`, has
+    ``camera``'s intrinsics: the inverse of the SDK's crop and scale. No lens distortion;
+    the accelerometer's ``Rt`` rotation is ``accel_rotation`` (3 x 3, depth to accelerometer)."""
+    from occupose.io.mkv import DEPTH_MODES
+
+    (binned_w, binned_h), (crop_x, crop_y), size = DEPTH_MODES[mode]
+    if size != (camera.width, camera.height):
+        raise ValueError(f"depth mode {mode} is {size[0]}x{size[1]}, the camera {camera.width}x{camera.height}")
+    params = [(camera.cx + 0.5 + crop_x) / binned_w, (camera.cy + 0.5 + crop_y) / binned_h,
+              camera.fx / binned_w, camera.fy / binned_h] + [0.0] * 10
+    identity = {"Rotation": [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0], "Translation": [0.0, 0.0, 0.0]}
+    depth = {"Intrinsics": {"ModelParameterCount": 14, "ModelParameters": params,
+                            "ModelType": "CALIBRATION_LensDistortionModelBrownConrady"},
+             "Location": "CALIBRATION_CameraLocationD0", "Purpose": "CALIBRATION_CameraPurposeDepth",
+             "MetricRadius": 1.74, "Rt": identity, "SensorHeight": 1024, "SensorWidth": 1024}
+    accel = {"SensorType": "CALIBRATION_InertialSensorType_Accelerometer",
+             "Rt": {"Rotation": [float(v) for v in np.ravel(accel_rotation)], "Translation": [0.0, 0.0, 0.0]}}
+    return {"CalibrationInformation": {"Cameras": [depth], "InertialSensors": [accel],
+                                       "Metadata": {"SerialId": "synthetic"}}}
+
+
+def _set_vfw_compression(path: Path, track_title: bytes, fourcc: bytes) -> None:
+    """Set the BITMAPINFOHEADER (``CodecPrivate``) of the track named ``track_title`` to
+    ``fourcc`` and a positive (top-down as k4arecorder writes it) height, in place."""
+    data = bytearray(path.read_bytes())
+    name = data.find(b"\x53\x6e" + bytes([0x80 | len(track_title)]) + track_title)
+    private = data.find(b"\x63\xa2\xa8", name)  # CodecPrivate, 40 bytes
+    if name < 0 or private < 0:
+        raise ValueError(f"{path}: no CodecPrivate for track {track_title!r}")
+    header = private + 3
+    if int.from_bytes(data[header:header + 4], "little") != 40:
+        raise ValueError(f"{path}: the track {track_title!r} has no BITMAPINFOHEADER")
+    height = int.from_bytes(data[header + 8:header + 12], "little", signed=True)
+    data[header + 8:header + 12] = abs(height).to_bytes(4, "little")
+    data[header + 16:header + 20] = fourcc
+    path.write_bytes(bytes(data))
+
+
+def write_depth_mkv(path: str | os.PathLike, depths, camera: Camera, *, mode: str | None = None,
+                    fps: float = 30.0, start_offset_ns: int = 0, calibration: dict | bool = True,
+                    accelerations=None, title: str = "DEPTH", accel_rotation=AZURE_ACCEL_ROTATION) -> Path:
+    """An Azure Kinect style ``.mkv`` of the depth images ``depths`` ((H, W) uint16 mm each),
+    written with PyAV, read back by :class:`occupose.io.mkv.MkvSource`.
+
+    A ``rawvideo`` track titled ``title`` (``K4A_DEPTH_MODE`` ``mode``, default the one of
+    the camera's size) whose packets are the images' big-endian bytes, stamped
+    ``index / fps`` (Matroska's millisecond timecodes, as FFmpeg writes them); the file's
+    ``K4A_START_OFFSET_NS`` tag; the ``calibration.json`` attachment
+    (:func:`azure_calibration` of ``camera``, a dict of your own, or none for False); and
+    with ``accelerations`` ((N, 3) m/s^2), a track titled ``IMU`` of N 40-byte
+    ``S_K4A/IMU`` samples (a stand-in codec: FFmpeg cannot mux ``S_K4A/IMU``, and the reader
+    finds the track by its name). FFmpeg writes a raw track's VFW header as BI_RGB: the
+    depth track's is set to ``b16g`` (gray16be), as k4arecorder writes it.
+    """
+    import json
+    from fractions import Fraction
+
+    import av
+
+    from occupose.io.mkv import DEPTH_MODES, IMU_SAMPLE
+
+    path = Path(path)
+    if mode is None:
+        mode = next(n for n, (_, _, size) in DEPTH_MODES.items() if size == (camera.width, camera.height))
+    microseconds = Fraction(1, 1_000_000)
+    with av.open(str(path), "w", format="matroska", options={"allow_raw_vfw": "1", "write_crc32": "0"}) as out:
+        out.metadata["title"] = "Azure Kinect"
+        out.metadata["K4A_START_OFFSET_NS"] = str(int(start_offset_ns))
+        stream = out.add_stream("rawvideo", rate=Fraction(fps).limit_denominator(1000))
+        stream.width, stream.height, stream.pix_fmt = camera.width, camera.height, "gray16be"
+        stream.metadata["title"] = title
+        stream.metadata["K4A_DEPTH_MODE"] = mode
+        imu = None
+        if accelerations is not None:
+            imu = out.add_stream("rawvideo", rate=1000)
+            imu.width, imu.height, imu.pix_fmt = 20, 1, "gray16be"
+            imu.metadata["title"] = "IMU"
+        if calibration is not False:
+            document = azure_calibration(camera, mode, accel_rotation=accel_rotation) if calibration is True \
+                else calibration
+            out.add_attachment("calibration.json", "application/octet-stream", json.dumps(document).encode())
+        out.start_encoding()
+        if imu is not None:
+            for index, acc in enumerate(np.asarray(accelerations, np.float32).reshape(-1, 3)):
+                sample = np.zeros(1, IMU_SAMPLE)
+                sample["acc"], sample["gyro"] = acc, 0.0
+                sample["acc_timestamp_ns"] = sample["gyro_timestamp_ns"] = start_offset_ns + index * 1_000_000
+                packet = av.Packet(sample.tobytes())
+                packet.stream, packet.time_base = imu, microseconds
+                packet.pts = packet.dts = index * 1000
+                out.mux(packet)
+        for index, depth in enumerate(depths):
+            depth = np.asarray(depth)
+            if depth.shape != (camera.height, camera.width) or depth.dtype != np.uint16:
+                raise ValueError(f"depth image {index} is {depth.dtype} {depth.shape}, expected uint16 "
+                                 f"({camera.height}, {camera.width})")
+            packet = av.Packet(depth.astype(">u2").tobytes())
+            packet.stream, packet.time_base = stream, microseconds
+            packet.pts = packet.dts = int(round(index * 1_000_000 / fps))
+            out.mux(packet)
+    _set_vfw_compression(path, title.encode(), b"b16g")
+    return path
+
+
+# ------------------------------------------------------------------------- TUM RGB-D folders
+
+def write_tum_folder(path: str | os.PathLike, depths, *, fps: float = 30.0, start: float = 1305031102.175304,
+                     stamps=None) -> Path:
+    """A TUM RGB-D folder of the depth images ``depths`` ((H, W) uint16, metres * 5000 each):
+    ``depth/<timestamp>.png`` (16-bit grayscale) and ``depth.txt`` listing them with the
+    dataset's three comment lines, stamped ``stamps`` or ``start + index / fps`` seconds
+    (6 decimals, as the dataset writes them); returns ``path``."""
+    from PIL import Image
+
+    path = Path(path)
+    (path / "depth").mkdir(parents=True, exist_ok=True)
+    lines = ["# depth maps", f"# file: '{path.name}.bag'", "# timestamp filename"]
+    for index, depth in enumerate(depths):
+        depth = np.asarray(depth)
+        if depth.dtype != np.uint16 or depth.ndim != 2:
+            raise ValueError(f"depth image {index} is {depth.dtype} {depth.shape}, expected (H, W) uint16")
+        stamp = f"{(start + index / fps) if stamps is None else stamps[index]:.6f}"
+        Image.fromarray(depth).save(path / "depth" / f"{stamp}.png")
+        lines.append(f"{stamp} depth/{stamp}.png")
+    (path / "depth.txt").write_text("\n".join(lines) + "\n")
+    return path

@@ -308,6 +308,9 @@ class BagSource(StreamSource):
             raise self._fail(f"{self.topic} could not be read ({type(error).__name__}: {error})") from None
 
 
-def open_bag(path: Path, *, topic: str | None = None) -> BagSource:
-    """The bag at ``path`` as a frame source (:class:`BagSource`); ``topic``: its depth image topic."""
+def open_bag(path: Path, *, topic: str | None = None, **options) -> BagSource:
+    """The bag at ``path`` as a frame source (:class:`BagSource`); ``topic``: its depth image
+    topic. Other reader options are a SourceError naming them."""
+    if options:
+        raise SourceError(f"{path}: a ROS bag takes only the reader option topic, got {sorted(options)}")
     return BagSource(Path(path), topic)

@@ -370,3 +370,9 @@ register_reader(Reader("folder", "occupose's recording folder (recording.json, <
 register_reader(Reader("bag", "a ROS 1 .bag (RealSense .bag too) or a ROS 2 bag (a folder with metadata.yaml, "
                        ".db3 or .mcap): one depth image topic", "ros", lazy("occupose.io.rosbag", "is_bag"),
                        lazy("occupose.io.rosbag", "open_bag")))
+register_reader(Reader("mkv", "an Azure Kinect .mkv (k4arecorder): its DEPTH track, the calibration attachment's "
+                       "intrinsics, the IMU's gravity", "kinect", lazy("occupose.io.mkv", "is_mkv"),
+                       lazy("occupose.io.mkv", "open_mkv")))
+register_reader(Reader("tum", "a TUM RGB-D folder (depth.txt, depth/*.png at 5000 units per metre; camera fr1, "
+                       "fr2, fr3 or given)", None, lazy("occupose.io.tum", "is_tum"),
+                       lazy("occupose.io.tum", "open_tum")))
