@@ -426,3 +426,22 @@ def write_tum_folder(path: str | os.PathLike, depths, *, fps: float = 30.0, star
         lines.append(f"{stamp} depth/{stamp}.png")
     (path / "depth.txt").write_text("\n".join(lines) + "\n")
     return path
+
+
+def random_raw_depths(count: int, size: tuple[int, int], low: int, high: int, seed: int = 0) -> np.ndarray:
+    """(count, H, W) uint16 raw depth images drawn uniformly from [low, high), a tenth of the
+    pixels 0 (no measurement): frames for the readers' round-trip tests."""
+    rng = np.random.default_rng(seed)
+    depths = rng.integers(low, high, (count, *size), dtype=np.uint16)
+    depths[rng.random(depths.shape) < 0.1] = 0
+    return depths
+
+
+def raw_frames(source) -> tuple[np.ndarray, list[float]]:
+    """((T, H, W) uint16 raw images, T times in seconds) of every frame of ``source``'s first
+    camera, back from the metres a frame source gives."""
+    from occupose.camera import raw_depth_from_metres
+
+    camera = source.cameras[0]
+    frames = list(source.frames())
+    return np.array([raw_depth_from_metres(f.depth[camera.name], camera) for f in frames]), [f.time for f in frames]

@@ -16,7 +16,7 @@ from occupose.io.recording import RecordingWriter  # noqa: E402
 from occupose.io.sources import (HeightTilt, NoWorldPoseError, SourceError, open_source, placement,  # noqa: E402
                                  reader_for)
 from occupose.paths import shared_data_dir  # noqa: E402
-from occupose.testing import AZURE_ACCEL_ROTATION, azure_calibration, write_depth_mkv  # noqa: E402
+from occupose.testing import random_raw_depths, raw_frames, AZURE_ACCEL_ROTATION, azure_calibration, write_depth_mkv  # noqa: E402
 
 POSE = HeightTilt(1.5, 20.0)
 CAMERA = Camera("cam", 320, 288, 250.25, 251.5, 160.75, 143.25, 0.001)  # NFOV 2x2 binned size
@@ -27,17 +27,8 @@ SHARED_NORMALISED = [0.5129697918891907, 0.5169235467910767, 0.4927808940410614,
 
 def raw_depths(count, camera=CAMERA, seed=0):
     """``count`` (H, W) uint16 images, a tenth of them 0 (no measurement)."""
-    rng = np.random.default_rng(seed)
-    depths = rng.integers(300, 9000, (count, camera.height, camera.width), dtype=np.uint16)
-    depths[rng.random(depths.shape) < 0.1] = 0
-    return depths
+    return random_raw_depths(count, (camera.height, camera.width), 300, 9000, seed)
 
-
-def raw_frames(source):
-    """The raw uint16 images and times of every frame, from the metres open_source gives."""
-    camera = source.cameras[0]
-    frames = list(source.frames())
-    return np.array([raw_depth_from_metres(f.depth[camera.name], camera) for f in frames]), [f.time for f in frames]
 
 
 def calibration_of(normalised):

@@ -14,8 +14,8 @@ from occupose.io.recording import Recording, RecordingWriter  # noqa: E402
 from occupose.io.rosbag import FLOAT_DEPTH_SCALE, BagSource, depth_from_image  # noqa: E402
 from occupose.io.sources import HeightTilt, SourceError, open_source, reader_for  # noqa: E402
 from occupose.paths import shared_data_dir  # noqa: E402
-from occupose.testing import (bag_typestore, camera_info_message, image_message, write_bag,  # noqa: E402
-                              write_depth_bag)
+from occupose.testing import (bag_typestore, camera_info_message, image_message, random_raw_depths,  # noqa: E402
+                              raw_frames, write_bag, write_depth_bag)
 
 POSE = HeightTilt(1.5, 20.0)
 CAMERA = Camera("cam", 64, 48, 250.25, 251.5, 31.75, 23.25, 0.001)
@@ -24,17 +24,8 @@ IMAGE, INFO = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo"
 
 def raw_depths(count, camera=CAMERA, seed=0):
     """``count`` (H, W) uint16 images, a tenth of them 0 (no measurement)."""
-    rng = np.random.default_rng(seed)
-    depths = rng.integers(300, 9000, (count, camera.height, camera.width), dtype=np.uint16)
-    depths[rng.random(depths.shape) < 0.1] = 0
-    return depths
+    return random_raw_depths(count, (camera.height, camera.width), 300, 9000, seed)
 
-
-def raw_frames(source):
-    """The raw uint16 images and times of every frame, from the metres open_source gives."""
-    camera = source.cameras[0]
-    frames = list(source.frames())
-    return np.array([raw_depth_from_metres(f.depth[camera.name], camera) for f in frames]), [f.time for f in frames]
 
 
 @pytest.mark.parametrize("ros, storage", [(1, None), (2, "sqlite3"), (2, "mcap")])

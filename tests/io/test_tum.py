@@ -12,7 +12,7 @@ from occupose.camera import Camera, raw_depth_from_metres
 from occupose.io.recording import Recording, RecordingWriter
 from occupose.io.sources import HeightTilt, SourceError, open_source, reader_for
 from occupose.io.tum import DEPTH_FACTOR, TUM_CAMERAS, TumSource, intrinsics_for, read_list
-from occupose.testing import write_tum_folder
+from occupose.testing import random_raw_depths, raw_frames, write_tum_folder
 
 POSE = HeightTilt(1.5, 20.0)
 INTRINSICS = {"fx": 250.25, "fy": 251.5, "cx": 31.75, "cy": 23.25}
@@ -20,16 +20,8 @@ INTRINSICS = {"fx": 250.25, "fy": 251.5, "cx": 31.75, "cy": 23.25}
 
 def raw_depths(count, size=(48, 64), seed=0):
     """``count`` (H, W) uint16 images (metres * 5000), a tenth of them 0 (no measurement)."""
-    rng = np.random.default_rng(seed)
-    depths = rng.integers(1500, 45000, (count, *size), dtype=np.uint16)
-    depths[rng.random(depths.shape) < 0.1] = 0
-    return depths
+    return random_raw_depths(count, size, 1500, 45000, seed)
 
-
-def raw_frames(source):
-    camera = source.cameras[0]
-    frames = list(source.frames())
-    return np.array([raw_depth_from_metres(f.depth[camera.name], camera) for f in frames]), [f.time for f in frames]
 
 
 def test_a_tum_folder_reads_back_bit_exactly_with_its_timestamps(tmp_path):
