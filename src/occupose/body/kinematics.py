@@ -8,8 +8,13 @@ from occupose.body import _kernels
 from occupose.body.model import BodyModel
 from occupose.joints import NUM_JOINTS
 
+#: The second, empty set of points of :func:`joints_from_poses`: read-only like a model's
+#: arrays, so that both functions call one compiled specialisation of each kernel (numba
+#: compiles another for writable arrays).
 _EMPTY_NODES = np.zeros(0, np.int64)
 _EMPTY_OFFSETS = np.zeros((0, 3))
+_EMPTY_NODES.setflags(write=False)
+_EMPTY_OFFSETS.setflags(write=False)
 
 
 def _check_poses(model: BodyModel, poses) -> np.ndarray:
