@@ -317,7 +317,7 @@ def run_tracking(rec, out: Path, config, method: str | None, seed: int, force: b
     with _progress(f"tracking ({method or 'custom'})") as progress:
         return track_into(out, rec, config, method=method, seed=seed, force=force,
                           progress=lambda n: progress(n, rec.num_frames), formats=formats, frame=frame,
-                          camera=camera)
+                          camera=camera, warm_up=lambda message: click.echo(message, err=True))
 
 
 def _output_formats() -> list[str]:

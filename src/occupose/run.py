@@ -35,7 +35,8 @@ class TrackingResult:
     tracks : {track id: (joints (T, 15, 3) float64 metres, NaN where not tracked,
         visible (T, 15) bool)}
     seconds : seconds spent per stage (grid, blobs, observations, pose) and ``total``
-        (all frames, reading excluded), ``startup`` (first frame, numba compilation included)
+        (all frames, reading excluded), ``startup`` (first frame, numba compilation included),
+        ``warm_up`` (the kernels compiled before the first frame, when asked for)
     fps : frames per second of tracking, the first frame (start-up) excluded
     num_frames : frames tracked
     config : the settings of the run; seed : its seed; model : the body model it used
@@ -121,7 +122,8 @@ def _as_recording(recording):
 
 
 def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: int = 0,
-                    progress: Callable[[int], None] | None = None, overlap: bool = False) -> TrackingResult:
+                    progress: Callable[[int], None] | None = None, overlap: bool = False,
+                    warm_up: bool | Callable[[str], None] = False) -> TrackingResult:
     """Track every person of a recording.
 
     recording : a frame source (:class:`occupose.io.sources.FrameSource`, e.g. a Recording) or the
@@ -130,6 +132,11 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     seed : the run's seed; progress : callable(n) after each frame, or None
     overlap : as :func:`track_frames`; off by default: on an idle 2-core machine the grid's
         thread competes with the likelihood kernels' two threads (benchmarks/bench_speed.py)
+    warm_up : compile the kernels of this run before its first frame
+        (:func:`occupose.warmup.warm_up`; once per machine and settings, a fraction of a second
+        after that): True, or a callable told once, with a message, when it compiles; the
+        seconds it took are ``seconds["warm_up"]``. False: each kernel compiles at its first
+        call, in the middle of tracking on a machine that has not compiled it before.
     With ``grid.noise_model`` measured, each camera's noise is measured from the first
     ``grid.noise_frames`` frames first (:func:`occupose.grid.noise.measure_noise`).
     The frames are read and decoded on a thread of their own, a few ahead
@@ -145,6 +152,7 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     seed, progress, overlap = seed_value(seed), callback(progress, "progress"), flag(overlap, "overlap")
     check_fps(recording.fps, config.limits)  # before the frames the noise is measured on are read
     check_cameras(recording.cameras, config.limits)
+    warm_seconds = _warm_up(config, recording.cameras, warm_up)
     noise = None
     if config.grid.noise_model == "measured":
         first = (frame.depth for frame in itertools.islice(recording.frames(color=False), config.grid.noise_frames))
@@ -153,7 +161,22 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     with Prefetch(recording.frames(color=False)) as frames:  # the next frames decoded while this one is tracked
         result = track_frames(tracker, frames, recording.num_frames, progress, overlap=overlap)
     result.cameras = placement(recording)
+    if warm_seconds is not None:
+        result.seconds["warm_up"] = warm_seconds
     return result
+
+
+def _warm_up(config: TrackerConfig, cameras, warm_up: bool | Callable[[str], None]) -> float | None:
+    """track_recording's warm-up: seconds it took, None when not asked for."""
+    from occupose import warmup
+
+    if warm_up is False:
+        return None
+    if warm_up is not True and not callable(warm_up):
+        raise TypeError(f"warm_up must be True, False or a callable(message), got {type(warm_up).__name__}")
+    start = time.perf_counter()
+    warmup.warm_up(config, cameras, report=warm_up if callable(warm_up) else None)
+    return round(time.perf_counter() - start, 3)
 
 
 def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method: str | None = None) -> dict:
@@ -206,15 +229,16 @@ def write_run(out: str | os.PathLike, result: TrackingResult, recording_path: st
 
 def track_into(out: str | os.PathLike, recording, config: TrackerConfig | str = "ours", *, method: str | None = None,
                seed: int = 0, force: bool = False, progress: Callable[[int], None] | None = None,
-               formats: Sequence[str] = (), frame: str = "world", camera: str | None = None
-               ) -> tuple[Path, TrackingResult]:
+               formats: Sequence[str] = (), frame: str = "world", camera: str | None = None,
+               warm_up: bool | Callable[[str], None] = False) -> tuple[Path, TrackingResult]:
     """:func:`track_recording`, then :func:`write_run` into ``out`` (``method`` names the
     config in the summary), with ``out`` checked and its hidden folder made before the
     tracking starts, so a run is not lost to an output that cannot be written. ``formats``
     : other outputs beside tracks.csv, ``tracks.<suffix>`` of each
     (:data:`occupose.io.writers.WRITERS`), in ``frame`` (``"world"`` or ``"camera"``, the
     camera named or the first: :func:`occupose.io.export.check_frame`), all checked before
-    the tracking (their optional packages too). Returns (the tracks.csv path, the result)."""
+    the tracking (their optional packages too); ``warm_up`` as :func:`track_recording`'s.
+    Returns (the tracks.csv path, the result)."""
     from occupose.io.export import check_frame
     from occupose.io.output import staged_folder
     from occupose.io.writers import writer_for
@@ -225,6 +249,6 @@ def track_into(out: str | os.PathLike, recording, config: TrackerConfig | str = 
         writer_for(name).check_available()
     check_frame(frame, camera, recording.cameras)
     with staged_folder(out, "run", force=force, inputs=(recording.path,)) as folder:
-        result = track_recording(recording, config, seed=seed, progress=progress)
+        result = track_recording(recording, config, seed=seed, progress=progress, warm_up=warm_up)
         _write_run_files(folder, result, recording, method, formats, frame, camera)
     return Path(out) / "tracks.csv", result

@@ -200,7 +200,7 @@ def run_method(recording: Path, scenario: str, method: str, seed: int, out: Path
 
     rec = Recording(recording)
     config = method_config(method).with_values(overrides or {})
-    result = track_recording(rec, config, seed=seed, progress=progress)
+    result = track_recording(rec, config, seed=seed, progress=progress, warm_up=True)  # no stall in the fps
     write_run(out, result, rec.path if recording_as is None else recording_as, method)
     gt = rec.groundtruth()
     joints = {tid: track[0] for tid, track in result.tracks.items()}

@@ -40,7 +40,7 @@ class RunResult:
     frame_errors : (T, P) float64, metres: D_t of each person over the joints the matched
         track reports (NaN where the person is not counted or has no estimate)
     fps : frames per second of tracking, start-up excluded
-    seconds : seconds per stage, ``total`` and ``startup`` (TrackingResult.seconds)
+    seconds : seconds per stage, ``total``, ``startup`` and ``warm_up`` (TrackingResult.seconds)
     arm_epsilon, truth_arm_epsilon : (T, P) float64, metres, or None for a recording
         without part labels: the second paper's arm error (pixels.arm_epsilons) of each
         person's matched track (NaN without an estimate) and of its ground truth
@@ -285,7 +285,7 @@ def speed_table(runs: Sequence[RunResult]) -> dict[str, dict[str, float]]:
         ms = 1000.0 * seconds / max(frames - len(mine), 1)
         entry = {"fps": 1000.0 / ms if ms > 0 else math.nan, "ms": ms}
         for key in _seconds_keys(mine):
-            if key not in ("total", "startup"):
+            if key not in ("total", "startup", "warm_up"):
                 entry[f"{key} ms"] = 1000.0 * sum(r.seconds.get(key, math.nan) for r in mine) / max(frames, 1)
         out[method] = entry
     return out
