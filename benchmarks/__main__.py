@@ -23,11 +23,12 @@ from benchmarks import (  # noqa: E402
     bench_robustness,
     bench_speed,
     bench_stages,
+    bench_startup,
     bench_tracking,
     format_table,
 )
 
-BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages,
+BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages, bench_startup,
               bench_robustness, bench_bag, bench_mkv]
 
 
