@@ -201,6 +201,57 @@ def show_cmd(recording, index, out, tracks, force, **source) -> None:
     click.echo(f"wrote {path}")
 
 
+@main.command("video")
+@click.argument("recording", type=click.Path(exists=True, path_type=Path))
+@_source_options
+@click.option("--tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path), required=True,
+              help="The tracks.csv to draw.")
+@click.option("--out", type=click.Path(path_type=Path), required=True,
+              help="MP4 file to write (.mp4 is appended to a name without a suffix).")
+@click.option("--camera", default=None, help="The camera to show (default: the recording's first).")
+@click.option("--fps", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Frames per second of the video (default: the recording's).")
+@click.option("--force", is_flag=True, help=_FORCE_HELP)
+def video_cmd(recording, tracks, out, camera, fps, force, **source) -> None:
+    """Write an MP4 video of RECORDING (any format, docs/inputs.md) seen by one camera:
+    every frame's depth colour-mapped, the TRACKS' skeletons drawn over it (docs/outputs.md)."""
+    from occupose.viz_video import write_video
+
+    try:
+        rec = _open(recording, **source)
+        track_data = _read_tracks(tracks, rec.num_frames, allow_unmarked=True)
+        with _progress("video") as progress:
+            path = write_video(rec, track_data, out, camera=camera, fps=fps, force=force,
+                               progress=lambda n: progress(n, rec.num_frames))
+    except (ValueError, FileNotFoundError, ImportError) as error:
+        _fail(str(error))
+    click.echo(f"wrote {path}")
+
+
+@main.command("view")
+@click.argument("recording", type=click.Path(exists=True, path_type=Path))
+@_source_options
+@click.option("--tracks", type=click.Path(exists=True, dir_okay=False, path_type=Path), required=True,
+              help="The tracks.csv to show.")
+@click.option("--out", type=click.Path(path_type=Path), required=True,
+              help="Rerun recording to write (.rrd is appended to a name without a suffix).")
+@click.option("--force", is_flag=True, help=_FORCE_HELP)
+def view_cmd(recording, tracks, out, force, **source) -> None:
+    """Write a rerun recording (.rrd, open it with `rerun FILE.rrd`) of RECORDING (any
+    format, docs/inputs.md): its cameras, depth images and the TRACKS' skeletons in 3D over
+    time (docs/outputs.md)."""
+    from occupose.viz_rerun import write_rerun
+
+    try:
+        rec = _open(recording, **source)
+        track_data = _read_tracks(tracks, rec.num_frames, allow_unmarked=True)
+        with _progress("rerun recording") as progress:
+            path = write_rerun(rec, track_data, out, force=force, progress=lambda n: progress(n, rec.num_frames))
+    except (ValueError, FileNotFoundError, ImportError) as error:
+        _fail(str(error))
+    click.echo(f"wrote {path}")
+
+
 @main.command("score")
 @click.argument("recording", type=click.Path(exists=True, path_type=Path))
 @_source_options

@@ -11,11 +11,33 @@ from occupose.joints import BONES
 from occupose.io.output import SOFTWARE, picture_path, staged_picture
 from occupose.io.recording import Recording
 
+#: The matplotlib colormap of depth images (every picture, video and rerun recording).
+DEPTH_COLORMAP = "turbo"
+#: Depth range of the colormap, metres: its low end, and the least its high end is
+#: (higher when the image has farther depths: :func:`depth_range`).
+DEPTH_RANGE_M = (0.5, 4.5)
+#: Colours of tracked skeletons (8-bit RGB), by track id (:func:`track_color`): none of
+#: them in the depth colormap, so a skeleton stands out on any depth.
+TRACK_COLORS = ((255, 255, 255), (255, 43, 214), (0, 229, 255), (255, 152, 0), (125, 255, 106), (160, 120, 255))
+
 
 def _depth_colors():
     import matplotlib
 
-    return matplotlib.colormaps["turbo"].with_extremes(bad="black")
+    return matplotlib.colormaps[DEPTH_COLORMAP].with_extremes(bad="black")
+
+
+def depth_range(depth: np.ndarray) -> tuple[float, float]:
+    """(low, high) metres of the depth colormap for ``depth`` ((H, W) metres, 0 or NaN =
+    none): :data:`DEPTH_RANGE_M`, its high end raised to the farthest depth."""
+    measured = depth[np.isfinite(depth) & (depth > 0)]
+    farthest = float(measured.max()) if measured.size else 0.0
+    return DEPTH_RANGE_M[0], max(DEPTH_RANGE_M[1], farthest)
+
+
+def track_color(track: int) -> tuple[int, int, int]:
+    """The 8-bit RGB colour of track id ``track`` (ids from 1): :data:`TRACK_COLORS` in turn."""
+    return TRACK_COLORS[(int(track) - 1) % len(TRACK_COLORS)]
 
 
 def _figure(width: int, height: int, panels: int):
@@ -74,7 +96,8 @@ def _draw_frame(recording: Recording, index: int, tracks: dict | None):
     colors = ["#ff2bd6", "#ffffff", "#7dff6a", "#ffd23f"]
     for ax, cam in zip(axes, cams):
         depth = np.where(frame.depth[cam.name] > 0, frame.depth[cam.name], np.nan)
-        im = ax.imshow(depth, cmap=_depth_colors(), vmin=0.5, vmax=max(4.5, float(np.nanmax(depth)) if np.any(depth > 0) else 4.5))
+        low, high = depth_range(depth)
+        im = ax.imshow(depth, cmap=_depth_colors(), vmin=low, vmax=high)
         ax.set_title(f"{recording.path.name} — {cam.name} — frame {index}", fontsize=8)
         ax.set_xlim(0, cam.width)
         ax.set_ylim(cam.height, 0)
