@@ -9,8 +9,10 @@ from pathlib import Path
 import occupose
 
 PACKAGE = Path(occupose.__file__).parent
-#: Modules allowed to import occupose.synth (relative to the package).
-MAY_IMPORT_SYNTH = ("synth/", "testing.py", "evaluation/", "cli.py")
+#: Modules allowed to import occupose.synth (relative to the package). warmup.py tracks a
+#: rendered scene only to compile the kernels and throws its tracks away (a run's tracks are
+#: the same with and without it: tests/test_warmup.py).
+MAY_IMPORT_SYNTH = ("synth/", "testing.py", "evaluation/", "cli.py", "warmup.py")
 
 
 def _imports(path: Path, root: Path = PACKAGE) -> list[tuple[int, str]]:
