@@ -42,21 +42,21 @@ class _Commands(click.Group):
                 signal.signal(signal.SIGTERM, previous)
 
 
-def _progress_bar(total: int, desc: str):
+def _progress_bar(total: int, desc: str, unit: str = "frame"):
     from tqdm import tqdm
 
-    return tqdm(total=total, desc=desc, unit="frame", dynamic_ncols=True, mininterval=1.0)
+    return tqdm(total=total, desc=desc, unit=unit, dynamic_ncols=True, mininterval=1.0)
 
 
 @contextlib.contextmanager
-def _progress(desc: str):
+def _progress(desc: str, unit: str = "frame"):
     """A progress callback ``report(n, total)``: its bar opens at the first call, once the
     command has checked its input and outputs and knows the total; closed at the end."""
     bars = []
 
     def report(n: int, total: int) -> None:
         if not bars:
-            bars.append(_progress_bar(total, desc))
+            bars.append(_progress_bar(total, desc, unit))
         bars[0].update(n)
 
     try:
@@ -155,11 +155,10 @@ def _source_options(command):
     return command
 
 
-def _open(recording: Path, reader=None, topic=None, tum_camera=None, camera_height=None, tilt=None,
-          pose_file=None, find_floor=False, floor=None):
-    """The recording at ``recording`` (any format) with its cameras placed (the
-    ``_source_options``); a pose found from the floor or given is printed to stderr."""
-    from occupose.io.sources import HeightTilt, open_source, placement
+def _source_kwargs(reader=None, topic=None, tum_camera=None, camera_height=None, tilt=None, pose_file=None,
+                   find_floor=False) -> dict:
+    """:func:`occupose.io.sources.open_source`'s keyword options from the ``_source_options``."""
+    from occupose.io.sources import HeightTilt
 
     if (camera_height is None) != (tilt is None):
         _fail("--camera-height and --tilt go together")
@@ -169,7 +168,15 @@ def _open(recording: Path, reader=None, topic=None, tum_camera=None, camera_heig
     options = {} if topic is None else {"topic": topic}
     if tum_camera is not None:
         options["camera"] = tum_camera
-    source = open_source(recording, format=reader, pose=pose, find_floor=find_floor, floor=floor, **options)
+    return {"format": reader, "pose": pose, "find_floor": find_floor, **options}
+
+
+def _open(recording: Path, floor=None, **source):
+    """The recording at ``recording`` (any format) with its cameras placed (the
+    ``_source_options``); a pose found from the floor or given is printed to stderr."""
+    from occupose.io.sources import open_source, placement
+
+    source = open_source(recording, floor=floor, **_source_kwargs(**source))
     for entry in placement(source):
         if entry["pose"] != "recording":
             click.echo(f"{entry['name']}: {entry['height_m']:.3f} m above the floor, tilted {entry['tilt_deg']:.1f} "
@@ -393,37 +400,53 @@ def _layers(text: str | None):
     return parsed[0] if len(parsed) == 1 else tuple(parsed)
 
 
+def _tracking_options(command):
+    """The options of a command that tracks: the settings (``_config_of``) and the outputs."""
+    options = [
+        click.option("--method", default=None, help="ours (default), apf, ps or part-based: the base of the settings."),
+        click.option("--model", type=click.Choice(["auto", "full", "upper"]), default=None,
+                     help="Body model; auto (default): upper for a ceiling camera, full otherwise."),
+        click.option("--filter", "filter_name", default=None, help="Particle filter (sir, apf, ps, apf+ps, part-based)."),
+        click.option("--likelihood", default=None, help="Likelihood (points, points+free, render, ...)."),
+        click.option("--particles", type=click.IntRange(min=1), default=None, help="Particles per person."),
+        click.option("--layers", default=None, help="Annealing layers: an integer or one per stage, e.g. 3,1,1."),
+        click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Random seed."),
+        click.option("--config", "config_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+                     default=None, help="TOML or JSON file of settings (see docs/configuration.md); options given "
+                     "here win."),
+        click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
+                     help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable; none for none)."),
+        click.option("--format", "output_format", type=click.Choice(["csv", *_output_formats()]), default="csv",
+                     show_default=True, help="Another output beside tracks.csv: OUT/tracks.json, .bvh or .c3d "
+                     "(docs/outputs.md)."),
+        click.option("--frame", type=click.Choice(["world", "camera"]), default="world", show_default=True,
+                     help=_FRAME_HELP),
+        click.option("--camera", default=None, help=_CAMERA_HELP),
+    ]
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
+def _config_of(method, model, filter_name, likelihood, particles, layers, config_file, assignments):
+    """The run's config and its base method's name from the ``_tracking_options``."""
+    values = {"pose.model": model, "pose.filter": filter_name, "pose.likelihood": likelihood,
+              "pose.particles": particles, "pose.layers": _layers(layers)}
+    return build_config(config_file, method, values, assignments)
+
+
 @main.command("track")
 @click.argument("recording", type=click.Path(exists=True, path_type=Path))
 @_source_options
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Folder for tracks.csv and summary.json.")
-@click.option("--method", default=None, help="ours (default), apf, ps or part-based: the base of the settings.")
-@click.option("--model", type=click.Choice(["auto", "full", "upper"]), default=None,
-              help="Body model; auto (default): upper for a ceiling camera, full otherwise.")
-@click.option("--filter", "filter_name", default=None, help="Particle filter (sir, apf, ps, apf+ps, part-based).")
-@click.option("--likelihood", default=None, help="Likelihood (points, points+free, render, ...).")
-@click.option("--particles", type=click.IntRange(min=1), default=None, help="Particles per person.")
-@click.option("--layers", default=None, help="Annealing layers: an integer or one per stage, e.g. 3,1,1.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Random seed.")
-@click.option("--config", "config_file", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
-              help="TOML or JSON file of settings (see docs/configuration.md); options given here win.")
-@click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
-              help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable; none for none).")
-@click.option("--format", "output_format", type=click.Choice(["csv", *_output_formats()]), default="csv",
-              show_default=True, help="Another output beside tracks.csv: OUT/tracks.json, .bvh or .c3d "
-              "(docs/outputs.md).")
-@click.option("--frame", type=click.Choice(["world", "camera"]), default="world", show_default=True,
-              help=_FRAME_HELP)
-@click.option("--camera", default=None, help=_CAMERA_HELP)
+@_tracking_options
 @click.option("--force", is_flag=True, help=_FORCE_HELP)
 def track_cmd(recording, out, method, model, filter_name, likelihood, particles, layers, seed, config_file,
               assignments, output_format, frame, camera, force, **source) -> None:
     """Track everyone in RECORDING (any format, docs/inputs.md): writes OUT/tracks.csv and
     OUT/summary.json (and OUT/tracks.FORMAT with --format) and prints the Table I row when
     the recording has ground truth."""
-    values = {"pose.model": model, "pose.filter": filter_name, "pose.likelihood": likelihood,
-              "pose.particles": particles, "pose.layers": _layers(layers)}
-    config, name = build_config(config_file, method, values, assignments)
+    config, name = _config_of(method, model, filter_name, likelihood, particles, layers, config_file, assignments)
     try:
         rec = _open(recording, floor=config.floor, **source)
         if rec.num_frames == 0:
@@ -439,6 +462,46 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
             click.echo(score_text(rec, tracks_path))
     except (ValueError, FileNotFoundError, ImportError) as error:
         _fail(str(error))
+
+
+@main.command("batch")
+@click.argument("inputs", nargs=-1, required=True, type=click.Path(exists=True, path_type=Path))
+@_source_options
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="Folder of the batch: OUT/<recording name>/ per recording and OUT/batch.csv.")
+@click.option("--jobs", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Recordings tracked at once, each in a worker process with one numba thread (1: in this process).")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Track on an existing Dask distributed cluster, e.g. tcp://host:8786 (extra dask), not locally.")
+@_tracking_options
+@click.option("--force", is_flag=True, help="Track again the recordings done earlier (otherwise skipped), replacing "
+              "only what occupose wrote.")
+def batch_cmd(inputs, out, jobs, scheduler, method, model, filter_name, likelihood, particles, layers, seed,
+              config_file, assignments, output_format, frame, camera, force, **source) -> None:
+    """Track every recording of INPUTS (any formats, the same options for all) into
+    OUT/<name>/, as `occupose track` would. Recordings done earlier are skipped; one that
+    fails is reported and the others go on. Prints a table at the end and writes it as
+    OUT/batch.csv; the exit status is 1 when any recording failed."""
+    from occupose.batch import TABLE, plan, summary_counts, table_text, track_batch, write_table
+
+    if scheduler is not None and jobs != 1:
+        _fail("--jobs is for this machine; a Dask cluster's workers are its own (give --jobs or --scheduler)")
+    config, name = _config_of(method, model, filter_name, likelihood, particles, layers, config_file, assignments)
+    try:
+        tasks = plan(inputs, out, config.to_dict(), method=name, seed=seed, source=_source_kwargs(**source),
+                     formats=() if output_format == "csv" else (output_format,), frame=frame, camera=camera,
+                     force=force)
+        with _progress("batch", unit="recording") as progress:
+            progress(0, len(tasks))
+            outcomes = track_batch(tasks, jobs=jobs, scheduler=scheduler, progress=lambda outcome: progress(1, len(tasks)))
+        table = write_table(out / TABLE, outcomes)
+    except (ValueError, ImportError, OSError) as error:
+        _fail(str(error))
+    click.echo(table_text(outcomes))
+    counts = summary_counts(outcomes)
+    click.echo(f"{counts['done']} done, {counts['skipped']} skipped (done earlier), {counts['failed']} failed -> {table}")
+    if counts["failed"]:
+        click.get_current_context().exit(1)
 
 
 @main.command("convert")
