@@ -400,8 +400,8 @@ def _layers(text: str | None):
     return parsed[0] if len(parsed) == 1 else tuple(parsed)
 
 
-def _tracking_options(command):
-    """The options of a command that tracks: the settings (``_config_of``) and the outputs."""
+def _settings_options(command):
+    """The options of a command that tracks: its settings (``_config_of``)."""
     options = [
         click.option("--method", default=None, help="ours (default), apf, ps or part-based: the base of the settings."),
         click.option("--model", type=click.Choice(["auto", "full", "upper"]), default=None,
@@ -416,6 +416,15 @@ def _tracking_options(command):
                      "here win."),
         click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
                      help="Any setting by its dotted name, e.g. --set pose.gate_m=0.3 (repeatable; none for none)."),
+    ]
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
+def _tracking_options(command):
+    """The options of a command that tracks into a run's folder: the settings and the outputs."""
+    options = [
         click.option("--format", "output_format", type=click.Choice(["csv", *_output_formats()]), default="csv",
                      show_default=True, help="Another output beside tracks.csv: OUT/tracks.json, .bvh or .c3d "
                      "(docs/outputs.md)."),
@@ -425,7 +434,7 @@ def _tracking_options(command):
     ]
     for option in reversed(options):
         command = option(command)
-    return command
+    return _settings_options(command)
 
 
 def _config_of(method, model, filter_name, likelihood, particles, layers, config_file, assignments):
@@ -502,6 +511,69 @@ def batch_cmd(inputs, out, jobs, scheduler, method, model, filter_name, likeliho
     click.echo(f"{counts['done']} done, {counts['skipped']} skipped (done earlier), {counts['failed']} failed -> {table}")
     if counts["failed"]:
         click.get_current_context().exit(1)
+
+
+@main.command("live")
+@click.option("--realsense", is_flag=True, required=True,
+              help="An Intel RealSense camera (extra realsense), the only kind of live camera so far.")
+@click.option("--device", "serial", default=None, metavar="SERIAL", help="The camera's serial number (default: the first).")
+@click.option("--bag", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+              help="Play a RealSense .bag in real time as if it were the camera.")
+@click.option("--out", type=click.Path(dir_okay=False, allow_dash=True, path_type=Path), default=Path("-"),
+              show_default=True, help="File of the JSON lines, one per tracked frame (-: standard output).")
+@click.option("--frames", "max_frames", type=click.IntRange(min=1), default=None,
+              help="Stop after N tracked frames (default: until the camera or bag ends, or Ctrl-C).")
+@click.option("--camera-height", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="The camera's height above the floor, metres (with --tilt; default: found from the floor).")
+@click.option("--tilt", type=click.FloatRange(-90, 90), default=None,
+              help="... and its optical axis' angle below the horizontal, degrees (90: straight down).")
+@click.option("--world-from-camera", "pose_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              default=None, help="A JSON file of the camera's pose (docs/inputs.md).")
+@_settings_options
+@click.option("--force", is_flag=True, help="Replace a JSON lines file occupose wrote at --out.")
+def live_cmd(realsense, serial, bag, out, max_frames, camera_height, tilt, pose_file, method, model, filter_name,
+             likelihood, particles, layers, seed, config_file, assignments, force) -> None:
+    """Track people as a RealSense camera delivers its frames, the newest each time: frames
+    the tracking has no time for are dropped and counted. One JSON line per tracked frame
+    (docs/outputs.md) to --out; a status line (frames, drops, latency) on stderr every second."""
+    from occupose.live import RealSenseCamera, track_live
+
+    config, _ = _config_of(method, model, filter_name, likelihood, particles, layers, config_file, assignments)
+    pose = _source_kwargs(camera_height=camera_height, tilt=tilt, pose_file=pose_file)["pose"]
+    try:
+        with RealSenseCamera(serial=serial, bag=bag) as camera, _json_lines(out, force) as stream:
+            summary = track_live(camera, config, out=stream, pose=pose, seed=seed, max_frames=max_frames,
+                                 status=lambda line: click.echo(line, err=True))
+    except (ValueError, FileNotFoundError, ImportError) as error:
+        _fail(str(error))
+    click.echo(f"camera placed from {'the floor' if summary.pose == 'floor' else 'the pose given'}; "
+               f"{summary.status()}", err=True)
+
+
+@contextlib.contextmanager
+def _json_lines(out: Path, force: bool):
+    """The stream of ``live``'s JSON lines: standard output for ``-``, else the file, written
+    as it goes (a live run has no end to wait for) and refused if it exists, unless ``force``
+    and occupose wrote it (its first line is one of occupose's records)."""
+    if str(out) == "-":
+        yield click.get_text_stream("stdout")
+        return
+    if out.exists() and not (force and _is_live_output(out)):
+        _fail(f"{out} exists" + (" and was not written by occupose live" if force else " (use --force to replace "
+                                                                              "a file occupose live wrote)"))
+    with open(out, "w", encoding="utf-8") as stream:
+        yield stream
+
+
+def _is_live_output(path: Path) -> bool:
+    import json
+
+    try:
+        with open(path, encoding="utf-8") as stream:
+            first = stream.readline()
+        return not first or {"frame", "device_frame", "people"} <= set(json.loads(first))
+    except (OSError, ValueError, TypeError):
+        return False
 
 
 @main.command("convert")

@@ -185,6 +185,12 @@ def folder_snapshot(folder: str | os.PathLike) -> dict[str, str]:
 #: The RealSense stream info message (librealsense's ``realsense_msgs/StreamInfo``), for
 #: :func:`write_depth_bag`'s RealSense layout.
 STREAM_INFO_MSG = "uint32 fps\nstring encoding\nbool is_recommended\n"
+#: The device of :func:`write_depth_bag`'s RealSense layout, as its recorder writes it.
+REALSENSE_DEVICE_INFO = (("Name", "Intel RealSense D435"), ("Serial Number", "000000000000"), ("Product Id", "0B07"))
+#: Log time (ns) of the RealSense layout's static messages, as its recorder writes them: the
+#: playback device takes a sensor's options (Depth Units) only from messages at the very
+#: start (1 ns: yes; 1 ms: ignored, the option's default 0.01 m taken), and none at 0.
+REALSENSE_STATIC_NS = 1
 
 
 def bag_typestore(ros: int):
@@ -263,8 +269,11 @@ def write_depth_bag(path: str | os.PathLike, depths, camera: Camera, *, ros: int
     float32 metres for ``32FC1``), stamped ``start + index / fps`` seconds, with the
     CameraInfo of ``camera``, in the common ROS layout (``/camera/depth/image_raw``,
     ``/camera/depth/camera_info``) or, with ``realsense``, in a RealSense recorder's
-    (``/file_version``, ``/device_0/sensor_0/Depth_0/...``, its stream info with ``fps`` and
-    the ``Depth Units`` option set to ``camera.depth_scale``). See :func:`write_bag`."""
+    (``/file_version``, the device's and sensor's info, ``/device_0/sensor_0/Depth_0/...``,
+    its stream info with ``fps``, the ``Depth Units`` option set to ``camera.depth_scale``,
+    frame numbers and metadata: a ROS 1 one plays in pyrealsense2's playback device with
+    ``encoding="mono16"``; give a small ``start``, as the recorder's log times start near 0,
+    since a real-time playback waits that long for the first frame). See :func:`write_bag`."""
     store = bag_typestore(ros)
     if realsense:
         ns = "/device_0/sensor_0/Depth_0"
@@ -272,19 +281,41 @@ def write_depth_bag(path: str | os.PathLike, depths, camera: Camera, *, ros: int
     else:
         topic, info = "/camera/depth/image_raw", "/camera/depth/camera_info"
     first = int(round(start * 1e9))  # stamps in integer ns: exact at any epoch
+    types = store.types
+    key_value = types["diagnostic_msgs/msg/KeyValue"]
+
+    def realsense_device(stamp: int):
+        """The device, its sensor, the Depth Units option and the stream, before the frames."""
+        yield "/file_version", "std_msgs/msg/UInt32", stamp, types["std_msgs/msg/UInt32"](data=3)
+        for key, value in REALSENSE_DEVICE_INFO:
+            yield "/device_0/info", "diagnostic_msgs/msg/KeyValue", stamp, key_value(key=key, value=value)
+        yield ("/device_0/sensor_0/info", "diagnostic_msgs/msg/KeyValue", stamp,
+               key_value(key="Name", value="Stereo Module"))
+        yield ("/device_0/sensor_0/option/Depth Units/value", "std_msgs/msg/Float32", stamp,
+               types["std_msgs/msg/Float32"](data=camera.depth_scale))
+        yield ("/device_0/sensor_0/option/Depth Units/description", "std_msgs/msg/String", stamp,
+               types["std_msgs/msg/String"](data="Number of meters represented by a single depth unit"))
+        yield f"{ns}/info", "realsense_msgs/msg/StreamInfo", stamp, types["realsense_msgs/msg/StreamInfo"](
+            fps=int(fps), encoding=encoding, is_recommended=True)
+        vector, quaternion = types["geometry_msgs/msg/Vector3"], types["geometry_msgs/msg/Quaternion"]
+        yield f"{ns}/tf/0", "geometry_msgs/msg/Transform", stamp, types["geometry_msgs/msg/Transform"](
+            translation=vector(x=0.0, y=0.0, z=0.0), rotation=quaternion(x=0.0, y=0.0, z=0.0, w=1.0))
 
     def messages():
-        if realsense:
-            yield "/file_version", "std_msgs/msg/UInt32", first, store.types["std_msgs/msg/UInt32"](data=3)
-            yield f"{ns}/info", "realsense_msgs/msg/StreamInfo", first, store.types["realsense_msgs/msg/StreamInfo"](
-                fps=int(fps), encoding=encoding, is_recommended=True)
-            yield ("/device_0/sensor_0/option/Depth Units/value", "std_msgs/msg/Float32", first,
-                   store.types["std_msgs/msg/Float32"](data=camera.depth_scale))
-        yield info, "sensor_msgs/msg/CameraInfo", first, camera_info_message(store, camera)
+        static = REALSENSE_STATIC_NS if realsense else first
+        if realsense:  # what librealsense's playback device needs to play it (ROS 1 only)
+            yield from realsense_device(static)
+        yield info, "sensor_msgs/msg/CameraInfo", static, camera_info_message(store, camera)
         for index, depth in enumerate(depths):
             stamp = first + int(round(index * 1e9 / fps))
-            yield topic, "sensor_msgs/msg/Image", stamp, image_message(
-                store, depth, encoding, stamp, bigendian=bigendian, padding=padding)
+            image = image_message(store, depth, encoding, stamp, bigendian=bigendian, padding=padding)
+            if realsense and hasattr(image.header, "seq"):  # the frame number, from 1
+                image.header.seq = index + 1
+            yield topic, "sensor_msgs/msg/Image", stamp, image
+            if realsense:
+                for key, value in (("timestamp_domain", "Hardware Clock"), ("Frame Counter", str(index + 1)),
+                                   ("Frame Timestamp", str(stamp // 1000))):
+                    yield f"{ns}/image/metadata", "diagnostic_msgs/msg/KeyValue", stamp, key_value(key=key, value=value)
 
     return write_bag(path, messages(), store, ros=ros, storage=storage)
 

@@ -79,24 +79,29 @@ def marker_key(config: TrackerConfig, model: str) -> str:
 
 
 def warm_up(config: TrackerConfig | str, cameras: Sequence[Camera], *,
-            report: Callable[[str], None] | None = None, folder: str | os.PathLike | None = None) -> bool:
+            report: Callable[[str], None] | None = None, folder: str | os.PathLike | None = None,
+            load: bool = False) -> bool:
     """Compile (or load) the kernels a run with ``config`` on ``cameras`` will call.
 
     Skipped when the marker of these settings and this body model exists in ``folder``
-    (default: :func:`cache_folder`; it holds one empty file per :func:`marker_key`).
-    ``report(message)`` is called once, before a warm-up that runs. Returns True when it ran.
+    (default: :func:`cache_folder`; it holds one empty file per :func:`marker_key`), unless
+    ``load``: then the scene is tracked anyway, so that this process has every kernel
+    loaded before its first frame (a live camera's frames do not wait for the cache, about
+    0.3 s at the first frame and at a person's start). ``report(message)`` is called once,
+    before a warm-up that compiles. Returns True when it ran.
     """
     config = as_config(config)
     model = model_of(config, cameras)
     marker = Path(cache_folder() / MARKERS if folder is None else folder) / marker_key(config, model)
-    if marker.exists():
+    marked = marker.exists()
+    if marked and not load:
         return False
     from occupose.run import track_frames
     from occupose.synth.generate import frames
     from occupose.synth.scenarios import build_scenario
     from occupose.tracker import Tracker
 
-    if report is not None:
+    if report is not None and not marked:
         report(f"compiling the tracker's kernels for this machine: once, about a minute (cached in {cache_folder()})")
     name, count = SCENES[model]
     scenario = build_scenario(name, use_mocap=False)
