@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 $(STAMP): pyproject.toml Makefile
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test,baseline,kinect,ros,c3d,rerun,dask]"
+	$(BIN)/python -m pip install --quiet -e ".[test,baseline,kinect,ros,c3d,rerun,dask,realsense]"
 	touch $(STAMP)
 
 demo: $(STAMP)
