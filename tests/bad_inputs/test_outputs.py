@@ -183,7 +183,7 @@ def test_refused_or_failed_outputs_change_nothing(place, row, arguments, status,
 def test_writability_is_checked_before_the_tracking(place, monkeypatch):
     """Row 104: an output that cannot be written fails before the first frame is tracked."""
     frames = []
-    monkeypatch.setattr(cli, "_progress_bar", lambda total, desc: _Bar(frames.append))
+    monkeypatch.setattr(cli, "_progress_bar", lambda total, desc, unit="frame": _Bar(frames.append))
     result = _invoke(["track", place / "rec", "--out", "/proc/occupose_out"])
     assert result.exit_code == 1 and "cannot write it" in result.output
     assert frames == []
@@ -211,7 +211,7 @@ def _signal_at(count: int, signum: int):
         if len(seen) == count:
             os.kill(os.getpid(), signum)
 
-    return lambda total, desc: _Bar(act)
+    return lambda total, desc, unit="frame": _Bar(act)
 
 
 INTERRUPTED = [
@@ -251,7 +251,7 @@ def test_an_interrupted_command_leaves_everything_as_it_was(place, monkeypatch, 
     assert folder_snapshot(place) == before
     assert signal.getsignal(signal.SIGTERM) == handler  # the command's handler is gone again
     if row.startswith("110"):  # nothing to clean by hand: the same command runs again, without --force
-        monkeypatch.setattr(cli, "_progress_bar", lambda total, desc: _Bar(lambda n: None))
+        monkeypatch.setattr(cli, "_progress_bar", lambda total, desc, unit="frame": _Bar(lambda n: None))
         assert _invoke(args).exit_code == 0 and Recording(place / "new").num_frames == FRAMES
 
 
