@@ -25,7 +25,7 @@ from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.occupancy import O, cells_from_depth
 from occupose.grid.pixels import PersonPixels
 from occupose.grid.spec import GridSpec
-from occupose.likelihood import observation_from_views
+from occupose.likelihood import Observation, observation_from_views
 from occupose.pose.person import Person
 from occupose.pose.search import best_sample, start_candidates, start_spread
 from occupose.pose.views import at_border, views_from_pixels
@@ -141,6 +141,22 @@ def start_person(points: np.ndarray, pixels: PersonPixels, depths: Mapping[str, 
     """
     size = dims_from_observation(points, size=config.size)
     person = Person(body_model(model_name, size.dims, size.girth), config, fps, rng, cameras)
+    best, _ = search_start(person, pixels, depths, velocity, cameras, config.start.steps)
+    person.centroid = np.asarray(centroid, float)
+    person.settle(best, velocity)
+    return person
+
+
+def search_start(person: Person, pixels: PersonPixels, depths: Mapping[str, np.ndarray], velocity: np.ndarray,
+                 cameras: Sequence[Camera], steps: int) -> tuple[np.ndarray, Observation]:
+    """The pose (D,) of a ``person`` without one (its model sized) that best explains its
+    ``pixels``, and the observation made of them: the best of the start candidates at the
+    headings of :func:`start_headings` and of their random perturbations, then ``steps``
+    steps of its filter on that observation. Settings from ``person.config.start``.
+
+    depths : camera name -> (H, W) float32 metres; velocity : (2,) m/s, its horizontal velocity
+    """
+    config = person.config
     seen = observation_from_views(views_from_pixels(pixels, depths, cameras, person.model, config.pose),
                                   config.pose.max_points)
     problem = person.problem
@@ -149,10 +165,8 @@ def start_person(points: np.ndarray, pixels: PersonPixels, depths: Mapping[str, 
     headings = start_headings(velocity, centre, cameras[0], config.start.headings, config.carry.walking_speed)
     candidates = start_candidates(person.model, centre, headings, config.start.seat_share)
     spread = start_spread(person.model, config.start)
-    best = best_sample(problem, candidates, spread, config.start.samples, rng)
+    best = best_sample(problem, candidates, spread, config.start.samples, person.estimator.filter.rng)
     person.estimator.initialise(best, spread)
-    for _ in range(config.start.steps):
+    for _ in range(steps):
         best = person.estimator.step(seen)
-    person.centroid = np.asarray(centroid, float)
-    person.settle(best, velocity)
-    return person
+    return best, seen
