@@ -31,6 +31,8 @@ _EXPORTS = {
     "write_run": "occupose.run",
     "TrackingResult": "occupose.run",
     "score": "occupose.evaluation.matching",
+    "fit_frame": "occupose.pose.single",
+    "FrameFit": "occupose.pose.single",
 }
 
 __all__ = ["__version__", *_EXPORTS]

@@ -604,6 +604,37 @@ class FloorConfig(_Section):
 
 
 @dataclass(frozen=True)
+class FitConfig(_Section):
+    """Fitting the body to one depth frame, with no background model, no motion and maybe no
+    floor (``occupose.pose.single``, ``occupose fit``)."""
+
+    _path = "fit"
+    background_m: float = setting(0.05, "with a background image, a pixel is the background unless it is at least "
+                                        "this much nearer", "m", above=0)
+    floor_m: float = setting(0.05, "with a floor, points lower than this above it are the floor", "m", low=0)
+    floor_points: int = setting(5000, "points of the frame (or its background image) the floor is fitted to, evenly "
+                                      "taken (floor.points for a recording's first frames)", "points", low=3)
+    floor_span: float = setting(1.0, "a plane fitted to the frame is its floor only when its points span this much "
+                                     "across it both ways (a chest seen from the front is a plane too)", "m", low=0)
+    join_m: float = setting(0.1, "points in cells of this size that touch (26 neighbours) are one person", "m",
+                            above=0)
+    min_points: int = setting(1000, "a person has at least this many points", "points", low=1)
+    min_height: float = setting(0.4, "... and spans at least this height (a hand held out towards the camera does "
+                                     "not)", "m", low=0)
+    min_part: int = setting(100, "a smaller group of at least this many points joins the nearest person ...",
+                              "points", low=1)
+    reach_m: float = setting(0.8, "... when within this of their points (a hand held out hides its forearm)", "m",
+                             low=0)
+    feet_height: float = setting(0.25, "with a floor, a person whose lowest point is below this has their legs in "
+                                       "view (model auto: the full body)", "m", low=0)
+    stature: float = setting(1.72, "stature taken when the feet are not in view (an average adult's)", "m",
+                             above=1.0, high=2.2)
+    steps: int = setting(15, "filter steps on the frame after the start search", "count", low=0)
+    visible_m: float = setting(0.15, "a fitted joint in the image is visible when a point of its person is this "
+                                     "near", "m", above=0)
+
+
+@dataclass(frozen=True)
 class LimitsConfig(_Section):
     """Bounds on what a run may cost and on what its cameras may be, checked before any work
     (``occupose.bounds``, ``occupose.grid.occupancy.spec_from_cameras``): a setting or a
@@ -661,6 +692,7 @@ class TrackerConfig(_Section):
     occlusion: OcclusionConfig = field(default_factory=OcclusionConfig)
     recover: RecoverConfig = field(default_factory=RecoverConfig)
     floor: FloorConfig = field(default_factory=FloorConfig)
+    fit: FitConfig = field(default_factory=FitConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
 
     def _check(self) -> None:
