@@ -473,6 +473,51 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
         _fail(str(error))
 
 
+@main.command("fit")
+@click.argument("images", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--camera", "camera_option", required=True, metavar="PRESET|FILE.json",
+              help="The camera: a preset (kinect_v1, kinect_v2, azure_nfov, realsense_d435) or a JSON file of width, "
+              "height, fx, fy, cx, cy and optionally world_from_camera (docs/inputs.md).")
+@click.option("--out", type=click.Path(path_type=Path), required=True,
+              help="Folder for tracks.csv, summary.json and a picture per image.")
+@click.option("--model", type=click.Choice(["auto", "full", "upper"]), default="auto", show_default=True,
+              help="Body model; auto: the full body when the legs are in view above a floor, else the upper body.")
+@click.option("--depth-scale", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Metres per unit of the images (default: the camera's, 0.001 for a preset; metres for a float .npy).")
+@click.option("--background", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+              help="An image of the empty scene from the same camera (default: every measured pixel is a person's "
+              "or the floor's, as in an image whose background was removed).")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Random seed.")
+@click.option("--config", "config_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              default=None, help="TOML or JSON file of settings (docs/configuration.md: fit, start, pose, size).")
+@click.option("--set", "assignments", multiple=True, metavar="KEY=VALUE",
+              help="Any setting by its dotted name, e.g. --set fit.steps=20 (repeatable).")
+@click.option("--force", is_flag=True, help=_FORCE_HELP)
+def fit_cmd(images, camera_option, out, model, depth_scale, background, seed, config_file, assignments,
+            force) -> None:
+    """Fit the body to each of the single depth IMAGES (16-bit PNG, .npy, or raw uint16 of the
+    camera's size) with no motion and no background model: OUT/tracks.csv (frame i = the
+    i-th image, a track per person and image), OUT/<image name>.png and OUT/summary.json.
+    Coordinates are the camera's (x right, y down, z forward, metres) unless the camera
+    file gives world_from_camera."""
+    from occupose.fit_run import fit_into
+    from occupose.io.depth_image import camera_from_option
+
+    config, _ = build_config(config_file, None, {}, assignments)
+    try:
+        camera, world = camera_from_option(camera_option)
+        with _progress("fitting", unit="image") as progress:
+            progress(0, len(images))
+            summary = fit_into(out, list(images), camera, world=world, model=model, background=background,
+                               depth_scale=depth_scale, config=config, seed=seed, force=force,
+                               progress=lambda n: progress(n, len(images)))
+    except (ValueError, FileNotFoundError) as error:
+        _fail(str(error))
+    seconds = sum(frame["seconds"] for frame in summary["frames"])
+    click.echo(f"{summary['people']} person(s) in {summary['images']} image(s), {seconds / summary['images']:.2f} s "
+               f"per image, coordinates in the {summary['frame']} frame -> {out / 'tracks.csv'}")
+
+
 @main.command("batch")
 @click.argument("inputs", nargs=-1, required=True, type=click.Path(exists=True, path_type=Path))
 @_source_options
