@@ -15,6 +15,7 @@ from benchmarks import (  # noqa: E402
     bench_bag,
     bench_blobs,
     bench_body,
+    bench_fit,
     bench_filters,
     bench_grid,
     bench_likelihood,
@@ -29,7 +30,7 @@ from benchmarks import (  # noqa: E402
 )
 
 BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages, bench_startup,
-              bench_robustness, bench_bag, bench_mkv]
+              bench_robustness, bench_fit, bench_bag, bench_mkv]
 
 
 def machine() -> str:
