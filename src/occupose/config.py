@@ -612,8 +612,6 @@ class FitConfig(_Section):
     background_m: float = setting(0.05, "with a background image, a pixel is the background unless it is at least "
                                         "this much nearer", "m", above=0)
     floor_m: float = setting(0.05, "with a floor, points lower than this above it are the floor", "m", low=0)
-    floor_points: int = setting(5000, "points of the frame (or its background image) the floor is fitted to, evenly "
-                                      "taken (floor.points for a recording's first frames)", "points", low=3)
     floor_span: float = setting(1.0, "a plane fitted to the frame is its floor only when its points span this much "
                                      "across it both ways (a chest seen from the front is a plane too)", "m", low=0)
     join_m: float = setting(0.1, "points in cells of this size that touch (26 neighbours) are one person", "m",

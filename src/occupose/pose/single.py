@@ -9,8 +9,8 @@ frame alone (``occupose fit``; the settings are the fields of
    block of nearer pixels: noise), less the floor's (points within ``floor_m`` of it) where
    the floor is known.
 2. **World.** The camera's world pose when it is given (z up, the floor at 0); else the
-   floor fitted to ``floor_points`` points of the background image, or without one of the
-   frame (:func:`occupose.geometry.floor.fit_floor`; its points must span ``floor_span`` across it
+   floor fitted to the background image, or without one to the frame
+   (:func:`occupose.geometry.floor.fit_floor`; its points must span ``floor_span`` across it
    in both directions: a chest seen from the front is a plane too), else none: the camera
    is taken as level (image up is up), and each person is placed so that their top is
    their stature above a floor of their own (a ceiling camera needs its pose or a floor).
@@ -137,8 +137,8 @@ def fit_frame(depth, camera: Camera, *, model: str = "auto", world: bool = False
     depth : (H, W) float metres of ``camera`` (0 = no measurement)
     model : "auto", "full" or "upper" (:data:`MODELS`)
     world : whether ``camera.world_from_camera`` is its pose in a world with z up and the
-        floor at 0 (else it is ignored, the floor is looked for in the frame, and the joints
-        come in the camera's frame)
+        floor at 0 (else it is ignored, the floor is looked for in the background image or
+        the frame, and the joints come in the camera's frame)
     background : None or (H, W) float metres, the same camera's view of the empty scene
     config : a TrackerConfig or method name (``fit``, ``start``, ``pose``, ``size`` ... sections)
     seed : seeds the fit (the same seed, the same fit)
@@ -156,7 +156,7 @@ def fit_frame(depth, camera: Camera, *, model: str = "auto", world: bool = False
     else:
         scene = np.where(mask, depth, 0) if background is None else background  # the empty scene shows it best
         seen = points_from_depth(scene, camera, frame="camera")[0]
-        found = fit_floor(seen, dataclasses.replace(config.floor, points=fit.floor_points))
+        found = fit_floor(seen, config.floor)
         if found is not None and _span(seen, found, config) < fit.floor_span:
             found = None  # a person's chest or back, seen from the front
         pose = _level_world() if found is None else found.world_from_camera()
