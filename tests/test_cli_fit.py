@@ -38,12 +38,16 @@ def images(tmp_path_factory):
     return folder, camera, frame
 
 
+def _fit_args(folder, second: str, camera_file: str, out) -> list[str]:
+    """``occupose fit`` of person.png and ``second`` with the empty scene as the background."""
+    return ["fit", str(folder / "person.png"), str(folder / second), "--camera", str(folder / camera_file),
+            "--background", str(folder / "empty.png"), "--out", str(out)]
+
+
 def test_fit_writes_tracks_pictures_and_summary_in_the_world_given(images, tmp_path):
     folder, camera, frame = images
     out = tmp_path / "out"
-    args = ["fit", str(folder / "person.png"), str(folder / "person_raw"), "--camera", str(folder / "placed.json"),
-            "--background", str(folder / "empty.png"), "--out", str(out)]
-    result = CliRunner().invoke(main, args)
+    result = CliRunner().invoke(main, _fit_args(folder, "person_raw", "placed.json", out))
     assert result.exit_code == 0, result.output
     assert "2 person(s) in 2 image(s)" in result.output and "world frame" in result.output
     tracks = read_joint_table(out / "tracks.csv", 2, "tracks")
@@ -72,8 +76,7 @@ def test_two_images_of_one_name_are_refused_before_anything_is_written(images, t
 def test_fit_in_the_camera_frame_pictures_each_image_and_refuses_to_overwrite(images, tmp_path):
     folder, camera, frame = images
     out = tmp_path / "out"
-    args = ["fit", str(folder / "person.png"), str(folder / "removed.npy"), "--camera", str(folder / "camera.json"),
-            "--background", str(folder / "empty.png"), "--out", str(out)]
+    args = _fit_args(folder, "removed.npy", "camera.json", out)
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 0, result.output
     summary = json.loads((out / "summary.json").read_text())
