@@ -2,9 +2,10 @@
 
 Every cell of a :class:`~occupose.grid.spec.GridSpec` runs a hidden Markov model with the
 states of the first paper (section III-A): ``O`` occupied by a static object, ``M``
-occupied by a moving object, ``E`` empty. Each frame, the cell centre is projected into
-every depth image; with ``l`` the centre's depth along that camera's optical axis and
-``d`` the measured depth at its pixel, ``epsilon = d - l`` gives the observation function
+occupied by a moving object, ``E`` empty. Each frame, every depth image is read at the
+pixel the cell centre projects to (found once, when the grid is made: the cameras do not
+move); with ``l`` the centre's depth along that camera's optical axis and ``d`` the
+measured depth at its pixel, ``epsilon = d - l`` gives the observation function
 (the paper's Fig. 3, :func:`observation_function`), a plateau as wide as the cell with
 edges blurred by the sensor's depth noise::
 
@@ -482,12 +483,14 @@ class OccupancyGrid:
         self.stepped = 0
 
     def _camera_arrays(self) -> None:
-        """Per-camera arrays of the kernel (module docstring of occupose.grid._kernels)."""
+        """Per-camera arrays of the kernel, and where every cell centre falls in every image
+        (module docstring of occupose.grid._kernels): the cameras do not move, so each cell's
+        pixel, depth and tail width are found once, here."""
         count = len(self.cameras)
-        self._rotations = np.empty((count, 3, 3))
-        self._translations = np.empty((count, 3))
-        self._intrinsics = np.empty((count, 4))
-        self._sizes = np.empty((count, 2), np.int64)
+        rotations = np.empty((count, 3, 3))
+        translations = np.empty((count, 3))
+        intrinsics = np.empty((count, 4))
+        sizes = np.empty((count, 2), np.int64)
         self._offsets = np.zeros(count, np.int64)
         self._half_extents = np.empty(count)
         lut_depths = np.arange(int(round(_LUT_DEPTH / _LUT_STEP)) + 1) * _LUT_STEP
@@ -495,10 +498,10 @@ class OccupancyGrid:
         offset = 0
         for c, cam in enumerate(self.cameras):
             pose = cam.camera_from_world
-            self._rotations[c] = pose[:3, :3]
-            self._translations[c] = pose[:3, 3]
-            self._intrinsics[c] = (cam.fx, cam.fy, cam.cx, cam.cy)
-            self._sizes[c] = (cam.width, cam.height)
+            rotations[c] = pose[:3, :3]
+            translations[c] = pose[:3, 3]
+            intrinsics[c] = (cam.fx, cam.fy, cam.cx, cam.cy)
+            sizes[c] = (cam.width, cam.height)
             self._offsets[c] = offset
             offset += cam.width * cam.height
             self._half_extents[c] = 0.5 * self.spec.cell * np.abs(pose[2, :3]).sum()
@@ -506,6 +509,15 @@ class OccupancyGrid:
             measured = isinstance(model, NoiseEstimate)
             self._sigma_lut[c] = model.std(lut_depths) if measured else depth_std(lut_depths, model)
         self._depth = np.empty(offset, np.float32)
+        num_cells = self.spec.num_cells
+        #: (N, C) each cell centre's flat pixel index in each image (-1: none), its depth along
+        #: the optical axis (metres) and the observation function's tail width there (metres).
+        self._pixels = np.empty((num_cells, count), np.int32)
+        self._depths_l = np.empty((num_cells, count))
+        self._widths = np.empty((num_cells, count))
+        _kernels.pixels_from_cells(np.asarray(self.spec.origin), self.spec.cell, *self.spec.shape, rotations,
+                                   translations, intrinsics, sizes, self._sigma_lut, _LUT_STEP, self.tail_width,
+                                   self._pixels, self._depths_l, self._widths)
 
     def depth_noise(self, depth_l, camera: str) -> np.ndarray:
         """The depth noise (one standard deviation, metres) the grid assumes for camera ``camera``
@@ -561,7 +573,8 @@ class OccupancyGrid:
             cell in its parallel loop.
 
         Runs one fused numba kernel over all cells (it releases the GIL, so another thread
-        can work meanwhile). A cell's HMM step is skipped where it would change nothing: the
+        can work meanwhile); it reads each cell centre's pixel, depth and tail width per
+        camera from tables made with the grid (20 bytes per cell and camera). A cell's HMM step is skipped where it would change nothing: the
         cell is not held, its last step left its probabilities bit for bit as they were, and
         every camera observes it as then with the same value of the observation function
         (seen through beyond the tails, on the surface, hidden beyond the tails, or not
@@ -578,13 +591,10 @@ class OccupancyGrid:
                 raise ValueError(f"hold must be a bool array of the grid's shape {self.spec.shape}, "
                                  f"got {hold.dtype} {hold.shape}")
             hold = np.ascontiguousarray(hold).reshape(-1)
-        nx, ny, nz = self.spec.shape
         self.stepped = _kernels.update_grid(
-            np.asarray(self.spec.origin), self.spec.cell, nx, ny, nz, self._rotations, self._translations,
-            self._intrinsics, self._sizes, self._offsets, self._depth, self._sigma_lut, _LUT_STEP,
-            self._half_extents, self.tail_width, self.p_occ, self.p_free, self.transition, self.held_transition,
-            hold, FLUSH, self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
-            self._quiet,
+            self.spec.shape[0], self._pixels, self._depths_l, self._widths, self._offsets, self._depth,
+            self._half_extents, self.p_occ, self.p_free, self.transition, self.held_transition, hold, FLUSH,
+            self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1), self._quiet,
         )
         self.num_updates += 1
 
