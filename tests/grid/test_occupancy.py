@@ -11,8 +11,9 @@ import pytest
 
 from occupose.camera import Camera, camera_preset, look_at, pixels_from_points, points_from_depth, sensor_spec
 from occupose.grid.occupancy import (
-    FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth,
-    frames_until_static, observation_function, spec_from_cameras, transition_matrix,
+    BYTES_PER_CELL, FLUSH, GRID_BYTES_PER_CELL, HIDDEN, P_FREE, P_OCC, TABLE_BYTES_PER_CELL, UNOBSERVED, VISIBLE,
+    E, M, O, OccupancyGrid, bytes_per_cell, cells_from_depth, frames_until_static, observation_function,
+    spec_from_cameras, transition_matrix,
 )
 from occupose.geometry.primitives import box
 from occupose.grid.spec import GridSpec
@@ -300,6 +301,18 @@ def test_projection_tables_match_numpy(cameras):
         behind, found = depths[:, c] <= 0, pixels[:, c] >= 0
         assert behind.sum() > 100 and found.sum() > 100 and (~behind & ~found).sum() > 100
         assert len(np.unique(pixels[found, c])) > 100 and np.all(widths[found, c] > 0)
+
+
+@pytest.mark.parametrize("cameras", [(TILTED,), (TILTED, CEILING)], ids=["one", "two"])
+def test_memory_estimate_counts_what_the_grid_keeps(cameras):
+    spec = GridSpec((-1.0, -1.0, 0.0), 0.1, (20, 18, 16))
+    grid = OccupancyGrid(spec, cameras)
+    arrays = [v for v in vars(grid).values() if isinstance(v, np.ndarray)]
+    per_cell = [v.nbytes for v in arrays if v.shape[0] in (spec.num_cells, spec.shape[0]) and v.size >= spec.num_cells]
+    assert len(per_cell) == 7  # beliefs, states, visibility, skip codes; pixels, depths, widths
+    assert sum(per_cell) == spec.num_cells * (GRID_BYTES_PER_CELL + TABLE_BYTES_PER_CELL * len(cameras))
+    assert bytes_per_cell(len(cameras)) == BYTES_PER_CELL  # the coverage check's peak, up to two cameras
+    assert bytes_per_cell(3) == GRID_BYTES_PER_CELL + 3 * TABLE_BYTES_PER_CELL == 76
 
 
 def test_cells_from_depth_matches_numpy(rng):

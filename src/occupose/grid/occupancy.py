@@ -132,10 +132,16 @@ INITIAL = GridConfig.initial
 DEFAULT_NOISE_MODEL = "structured_light"
 #: Far range (metres) for cameras whose intrinsics match no sensor preset.
 DEFAULT_MAX_RANGE = 4.5
-#: Peak bytes per cell while a grid is made and updated (measured on no_occlusion's grid at
-#: 0.4, 1.9 and 6.5 M cells: 71 B; the coverage check's cell centres and their projections
-#: dominate): the memory estimate of :func:`spec_from_cameras`'s ``max_cells``.
+#: Peak bytes per cell while a grid is made, whatever the number of cameras: the coverage
+#: check's cell centres and their projections, freed before the grid's own arrays are made
+#: (tracemalloc: 72.0 B on no_occlusion's grid at 0.4, 1.9 and 6.5 M cells and on
+#: two_cameras_occlusion's at 0.7 and 3.3 M; docs/notes/2026-12-06-grid-projection-tables.md).
 BYTES_PER_CELL = 72
+#: Bytes per cell an :class:`OccupancyGrid` keeps: the (O, M, E) beliefs (3 float32), the
+#: state, the visibility and the kernel's skip code (uint16).
+GRID_BYTES_PER_CELL = 16
+#: ... and per cell and camera: the cell centre's pixel (int32), depth and tail width (float64).
+TABLE_BYTES_PER_CELL = 20
 #: Posterior probabilities below this are set to 0 (float32 never goes subnormal).
 FLUSH = 1e-30
 _LUT_STEP = 0.01
@@ -323,7 +329,7 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
         is not used)
     max_cells : None, or the most cells the grid may have (``limits.grid_cells``): a larger
         grid is refused before anything is allocated, with its size and memory
-        (:data:`BYTES_PER_CELL`)
+        (:func:`bytes_per_cell` of the number of cameras)
     Returns the GridSpec covering the bounding box of the cameras' view pyramids clipped
     to 0 <= z <= height (or ``bounds``), extended down to z = -cell / 2 so that the bottom
     layer of cells is centred on the floor: the cell centres' rays then meet the floor
@@ -338,7 +344,7 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
     far = _max_ranges(cameras, max_range)
     if bounds is not None:
         low, high = (np.asarray(b, np.float64) for b in bounds)
-        _check_size(low, high, cell, max_cells)
+        _check_size(low, high, cell, max_cells, len(cameras))
         spec = GridSpec.from_bounds(low, high, cell)
     else:
         if not (isinstance(height, (int, float, np.floating)) and math.isfinite(height) and height > 0):
@@ -355,24 +361,33 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
         low = points.min(axis=0)
         low[2] = -0.5 * cell  # the bottom layer is centred on the floor
         high = points.max(axis=0)
-        _check_size(low, high, cell, max_cells)
+        _check_size(low, high, cell, max_cells, len(cameras))
         spec = GridSpec.from_bounds(low, high, cell)
     _check_coverage(spec, cameras, far)
     return spec
 
 
-def _check_size(low: np.ndarray, high: np.ndarray, cell: float, max_cells: int | None) -> None:
-    """ValueError with the grid's size and memory when the box from ``low`` to ``high``
-    (metres) holds more than ``max_cells`` cells of ``cell`` metres (counted in floats: no
-    overflow, nothing allocated)."""
+def bytes_per_cell(num_cameras: int) -> int:
+    """Peak bytes per cell of making and updating a grid seen by ``num_cameras`` cameras:
+    the larger of the coverage check's :data:`BYTES_PER_CELL` and what the grid keeps,
+    :data:`GRID_BYTES_PER_CELL` + :data:`TABLE_BYTES_PER_CELL` per camera (72 B up to two
+    cameras, 76 B for three, 96 B for four; each camera's image adds 4 bytes a pixel)."""
+    return max(BYTES_PER_CELL, GRID_BYTES_PER_CELL + TABLE_BYTES_PER_CELL * int(num_cameras))
+
+
+def _check_size(low: np.ndarray, high: np.ndarray, cell: float, max_cells: int | None, num_cameras: int) -> None:
+    """ValueError with the grid's size and memory (:func:`bytes_per_cell`) when the box from
+    ``low`` to ``high`` (metres) holds more than ``max_cells`` cells of ``cell`` metres
+    (counted in floats: no overflow, nothing allocated)."""
     counts = np.ceil((np.asarray(high) - np.asarray(low)) / cell - 1e-9)
     cells = float(np.prod(counts))
     if max_cells is not None and cells > max_cells:
+        per_cell = bytes_per_cell(num_cameras)
         raise ValueError(f"grid.cell = {cell:g} m gives a grid of {' x '.join(f'{c:.0f}' for c in counts)} = "
                          f"{cells:.3g} cells over the cameras' view "
                          f"({' x '.join(f'{v:.3g}' for v in np.asarray(high) - low)} m), about "
-                         f"{cells * BYTES_PER_CELL / 1e9:.3g} GB; the bound limits.grid_cells is {max_cells:,} cells "
-                         f"(about {max_cells * BYTES_PER_CELL / 1e9:.2g} GB): use a larger grid.cell, or a shorter "
+                         f"{cells * per_cell / 1e9:.3g} GB; the bound limits.grid_cells is {max_cells:,} cells "
+                         f"(about {max_cells * per_cell / 1e9:.2g} GB): use a larger grid.cell, or a shorter "
                          f"grid.max_range or grid.height")
 
 
