@@ -641,9 +641,9 @@ class LimitsConfig(_Section):
     (``docs/notes/2026-12-04-bounds.md`` has the figures); raise one to go past it."""
 
     _path = "limits"
-    grid_cells: int = setting(20_000_000, "most cells of the occupancy grid (about 72 bytes each while it is made: "
-                                          "1.4 GB; the largest default grid of the scenes is 0.8 M cells, 12 M at "
-                                          "grid.cell 0.02)", "cells", low=1)
+    grid_cells: int = setting(20_000_000, "most cells of the occupancy grid (about 72 bytes each with one or two "
+                                          "cameras: 1.4 GB; 16 plus 20 per camera with more; the largest default "
+                                          "grid of the scenes is 0.8 M cells, 12 M at grid.cell 0.02)", "cells", low=1)
     evaluations: int = setting(100_000, "most likelihood evaluations per person and frame, pose.particles times "
                                         "the filter's layers or stages (ours: 1000, ps: 6000; about 0.7 s a "
                                         "person and frame on one core at 1000 points)", "evaluations", low=1)

@@ -1,4 +1,5 @@
-"""Stage 1: the occupancy grid's HMM and observation function against NumPy references, and
+"""Stage 1: the occupancy grid's HMM, observation function and projection tables (each cell
+centre's pixel, depth and tail width per camera) against NumPy references, and
 on rendered scenes (procedural motion, no shared data): a person extracted as moving, a
 moved chair that becomes background again after the time psi implies, cells hidden behind
 a desk."""
@@ -10,8 +11,9 @@ import pytest
 
 from occupose.camera import Camera, camera_preset, look_at, pixels_from_points, points_from_depth, sensor_spec
 from occupose.grid.occupancy import (
-    FLUSH, HIDDEN, P_FREE, P_OCC, UNOBSERVED, VISIBLE, E, M, O, OccupancyGrid, cells_from_depth,
-    frames_until_static, observation_function, spec_from_cameras, transition_matrix,
+    BYTES_PER_CELL, FLUSH, GRID_BYTES_PER_CELL, HIDDEN, P_FREE, P_OCC, TABLE_BYTES_PER_CELL, UNOBSERVED, VISIBLE,
+    E, M, O, OccupancyGrid, bytes_per_cell, cells_from_depth, frames_until_static, observation_function,
+    spec_from_cameras, transition_matrix,
 )
 from occupose.geometry.primitives import box
 from occupose.grid.spec import GridSpec
@@ -245,6 +247,72 @@ def test_update_kernel_with_hold_matches_numpy(rng):
         grid.update(depths, hold=np.zeros(grid.spec.shape, np.uint8))
     with pytest.raises(ValueError, match="hold must be a bool array"):
         grid.update(depths, hold=np.zeros(grid.spec.num_cells, bool))
+
+
+def reference_tables(grid: OccupancyGrid):
+    """What pixels_from_cells finds, in plain NumPy from each Camera's own projection:
+    (pixels (N, C) flat index v * width + u or -1, depths (N, C) metres along the optical
+    axis, widths (N, C) metres, 0 where no pixel, ambiguous (N, C) bool where a centre lies
+    within 1e-9 of a pixel edge or of a 1 cm step of the noise table, so rounding may go
+    either way)."""
+    centres = grid.spec.centers().reshape(-1, 3)
+    shape = (len(centres), len(grid.cameras))
+    pixels, depths, widths = np.full(shape, -1), np.empty(shape), np.zeros(shape)
+    ambiguous = np.zeros(shape, bool)
+    for c, cam in enumerate(grid.cameras):
+        uv, depth_l = pixels_from_points(centres, cam)
+        depths[:, c] = depth_l
+        front = depth_l > 0
+        u, v = np.floor(uv[front, 0] + 0.5), np.floor(uv[front, 1] + 0.5)
+        inside = np.zeros(len(centres), bool)
+        inside[front] = (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+        pixels[inside, c] = (v * cam.width + u)[inside[front]].astype(int)
+        step = np.minimum((depth_l[inside] * 100.0).astype(int), 1200)  # the grid's 1 cm table up to 12 m
+        widths[inside, c] = grid.tail_width * depth_std(step * 0.01, grid.noise_models[cam.name])
+        near_edge = np.zeros(len(centres), bool)
+        near_edge[front] = np.any(np.abs(np.mod(uv[front] + 0.5, 1.0) - 0.5) > 0.5 - 1e-9, axis=1)
+        scaled = depth_l * 100.0
+        ambiguous[:, c] = near_edge | (np.abs(scaled - np.round(scaled)) < 1e-9)
+    return pixels, depths, widths, ambiguous
+
+
+TILTED = Camera("tilted", 64, 48, 50.0, 52.0, 31.7, 23.2,
+                world_from_camera=look_at((0.3, -0.2, 1.4), (0.8, 2.0, 0.6)))
+# not at a whole number of centimetres above the cell centres, so that no centre's depth
+# lies on a step of the noise table, where the two ways of summing may round apart
+CEILING = Camera("ceiling", 60, 50, 45.0, 45.0, 29.6, 24.3,
+                 world_from_camera=look_at((0.1, 0.05, 1.337), (0.1, 0.05, 0.0)))
+
+
+@pytest.mark.parametrize("cameras", [(TILTED,), (CEILING,), (TILTED, CEILING)], ids=["tilted", "ceiling", "both"])
+def test_projection_tables_match_numpy(cameras):
+    # both cameras stand inside the grid box: cells behind them, in front but outside the
+    # image, and in the image
+    spec = GridSpec((-1.0, -1.0, 0.0), 0.1, (20, 18, 16))
+    models = dict(zip([c.name for c in cameras], ("structured_light", "tof")))
+    grid = OccupancyGrid(spec, cameras, models)
+    pixels, depths, widths, ambiguous = reference_tables(grid)
+    assert grid._pixels.shape == grid._depths_l.shape == grid._widths.shape == pixels.shape
+    assert ambiguous.mean() < 0.001
+    np.testing.assert_allclose(grid._depths_l, depths, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(grid._pixels[~ambiguous], pixels[~ambiguous])
+    np.testing.assert_array_equal(grid._widths[~ambiguous], widths[~ambiguous])
+    for c in range(len(cameras)):
+        behind, found = depths[:, c] <= 0, pixels[:, c] >= 0
+        assert behind.sum() > 100 and found.sum() > 100 and (~behind & ~found).sum() > 100
+        assert len(np.unique(pixels[found, c])) > 100 and np.all(widths[found, c] > 0)
+
+
+@pytest.mark.parametrize("cameras", [(TILTED,), (TILTED, CEILING)], ids=["one", "two"])
+def test_memory_estimate_counts_what_the_grid_keeps(cameras):
+    spec = GridSpec((-1.0, -1.0, 0.0), 0.1, (20, 18, 16))
+    grid = OccupancyGrid(spec, cameras)
+    arrays = [v for v in vars(grid).values() if isinstance(v, np.ndarray)]
+    per_cell = [v.nbytes for v in arrays if v.shape[0] in (spec.num_cells, spec.shape[0]) and v.size >= spec.num_cells]
+    assert len(per_cell) == 7  # beliefs, states, visibility, skip codes; pixels, depths, widths
+    assert sum(per_cell) == spec.num_cells * (GRID_BYTES_PER_CELL + TABLE_BYTES_PER_CELL * len(cameras))
+    assert bytes_per_cell(len(cameras)) == BYTES_PER_CELL  # the coverage check's peak, up to two cameras
+    assert bytes_per_cell(3) == GRID_BYTES_PER_CELL + 3 * TABLE_BYTES_PER_CELL == 76
 
 
 def test_cells_from_depth_matches_numpy(rng):

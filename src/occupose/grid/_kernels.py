@@ -1,9 +1,12 @@
-"""Numba kernel of the occupancy grid (private: use :class:`occupose.grid.occupancy.OccupancyGrid`).
+"""Numba kernels of the occupancy grid (private: use :class:`occupose.grid.occupancy.OccupancyGrid`).
 
-One fused kernel does a whole frame: for every cell (in parallel over x slices, without
-the GIL) it projects the cell centre into each camera, reads the depth pixel, evaluates
-the observation function, runs one forward step of the cell's three-state HMM, and
-writes the MAP state and the cell's visibility.
+The cameras do not move, so where a cell centre falls in each image is found once, when
+the grid is made (:func:`pixels_from_cells`: each cell's pixel, its depth along the
+optical axis and the observation function's tail width there, per camera). Then one
+fused kernel does a whole frame (:func:`update_grid`): for every cell (in parallel over
+x slices, without the GIL) it reads the depth pixel of the cell centre in each camera,
+evaluates the observation function, runs one forward step of the cell's three-state
+HMM, and writes the MAP state and the cell's visibility.
 
 Conventions shared with the wrapper:
 
@@ -13,9 +16,10 @@ Conventions shared with the wrapper:
 - camera ``c``: ``rotations[c]`` (3, 3) and ``translations[c]`` (3,) take world points to the
   camera frame (``p_cam = R p_world + t``); ``intrinsics[c] = (fx, fy, cx, cy)``;
   ``sizes[c] = (width, height)``; its depth image (metres, float32, row-major) starts at
-  ``offsets[c]`` in ``depth``; ``sigma_lut[c, m]`` is its depth noise (one standard deviation,
-  metres) at depth ``m * lut_step``; ``half_extents[c]`` is half a cell's extent along its
-  optical axis (metres);
+  ``offsets[c]`` in ``depth``, pixel ``(u, v)`` at ``offsets[c] + v * width + u``;
+  ``sigma_lut[c, m]`` is its depth noise (one standard deviation, metres) at depth
+  ``m * lut_step``; ``half_extents[c]`` is half a cell's extent along its optical axis
+  (metres);
 - ``hold`` is an (N,) bool array over the flat cells, or an empty array for none: a held
   cell takes its forward step with ``held`` instead of ``transition``, and when its MAP
   state before the step is M, its O share first moves to M (the tracker's hold on the
@@ -65,16 +69,67 @@ def observation(epsilon, half_extent, width, p_occ, p_free):
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
-def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, offsets, depth,
-                sigma_lut, lut_step, half_extents, tail_width, p_occ, p_free, transition, held, hold,
+def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, sigma_lut, lut_step,
+                      tail_width, pixels, depths_l, widths):
+    """Where every cell centre falls in every camera's image, in place (once per grid: the
+    cameras do not move).
+
+    origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
+    rotations (C, 3, 3), translations (C, 3), intrinsics (C, 4) float64; sizes (C, 2) int64
+    sigma_lut (C, L) float64 metres; lut_step float metres; tail_width : float, noise stds
+    pixels : (N, C) int32 out, the flat pixel index ``v * width + u`` of cell n's centre in
+        camera c's image, -1 where the centre is behind the camera or outside the image
+    depths_l : (N, C) float64 out, metres, the centre's depth along the optical axis
+        (``column + k * cell * rotation`` from the centre of cell (i, j, 0): update_grid's
+        results depend on these exact values)
+    widths : (N, C) float64 out, metres, the observation function's tail width
+        ``tail_width * sigma_lut[c, min(int(depth_l / lut_step), L - 1)]`` (0 where pixel is -1)
+    """
+    num_cameras = rotations.shape[0]
+    lut_last = sigma_lut.shape[1] - 1
+    lut_scale = 1.0 / lut_step
+    for i in numba.prange(nx):
+        x = origin[0] + cell * (i + 0.5)
+        column = np.empty((num_cameras, 3))  # camera-frame centre of cell (i, j, k)
+        for j in range(ny):
+            y = origin[1] + cell * (j + 0.5)
+            z0 = origin[2] + 0.5 * cell
+            for c in range(num_cameras):
+                for r in range(3):
+                    column[c, r] = (rotations[c, r, 0] * x + rotations[c, r, 1] * y + rotations[c, r, 2] * z0
+                                    + translations[c, r])
+            for k in range(nz):
+                n = (i * ny + j) * nz + k
+                for c in range(num_cameras):
+                    xc = column[c, 0] + k * cell * rotations[c, 0, 2]
+                    yc = column[c, 1] + k * cell * rotations[c, 1, 2]
+                    depth_l = column[c, 2] + k * cell * rotations[c, 2, 2]
+                    depths_l[n, c] = depth_l
+                    pixels[n, c] = -1
+                    widths[n, c] = 0.0
+                    if depth_l <= 0.0:
+                        continue
+                    inverse = 1.0 / depth_l
+                    u = math.floor(intrinsics[c, 0] * xc * inverse + intrinsics[c, 2] + 0.5)
+                    v = math.floor(intrinsics[c, 1] * yc * inverse + intrinsics[c, 3] + 0.5)
+                    if u < 0 or u >= sizes[c, 0] or v < 0 or v >= sizes[c, 1]:
+                        continue
+                    pixels[n, c] = int(v) * sizes[c, 0] + int(u)
+                    widths[n, c] = tail_width * sigma_lut[c, min(int(depth_l * lut_scale), lut_last)]
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
+def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, p_occ, p_free, transition, held, hold,
                 flush, probabilities, states, visibility, quiet):
     """One frame of the grid, in place; returns the number of cells whose HMM step ran.
 
-    origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
-    rotations (C, 3, 3), translations (C, 3), intrinsics (C, 4) float64; sizes (C, 2),
+    nx : int, the grid's x slices (run in parallel; the N cells are nx slices of N / nx)
+    pixels (N, C) int32, depths_l (N, C) float64 metres, widths (N, C) float64 metres: each
+        cell centre's pixel in each camera's image (-1: none), depth along its optical axis
+        and tail width, from :func:`pixels_from_cells`
     offsets (C,) int64; depth (sum H*W,) float32 metres (<= 0 or not finite: no measurement)
-    sigma_lut (C, L) float64 metres; lut_step float metres; half_extents (C,) float64 metres
-    tail_width, p_occ, p_free : floats of the observation function (tail width in noise stds)
+    half_extents (C,) float64 metres
+    p_occ, p_free : floats of the observation function
     transition : (3, 3) float64, row = previous state, column = next state
     held : (3, 3) float64, the transition matrix of held cells (only its M row may differ from
         ``transition``); hold : (N,) bool or (0,) bool
@@ -91,124 +146,105 @@ def update_grid(origin, cell, nx, ny, nz, rotations, translations, intrinsics, s
         stepped in its x slice with the same code (cells never seen, which share their
         history) takes that step's result without computing it.
     """
-    num_cameras = rotations.shape[0]
+    num_cameras = pixels.shape[1]
+    slice_cells = pixels.shape[0] // nx
     use_hold = hold.size > 0
     use_quiet = num_cameras <= QUIET_CAMERAS
     t_oo, t_om, t_oe = transition[0, 0], transition[0, 1], transition[0, 2]
     t_mo, t_mm, t_me = transition[1, 0], transition[1, 1], transition[1, 2]
     t_eo, t_em, t_ee = transition[2, 0], transition[2, 1], transition[2, 2]
     h_mo, h_mm, h_me = held[1, 0], held[1, 1], held[1, 2]
-    lut_last = sigma_lut.shape[1] - 1
-    lut_scale = 1.0 / lut_step
     stepped = 0
     for i in numba.prange(nx):
-        x = origin[0] + cell * (i + 0.5)
-        column = np.empty((num_cameras, 3))  # camera-frame centre of cell (i, j, k)
         last_code = 0  # the last unheld step of code > 0 in this slice: its input and output
         last_in = np.zeros(3, np.float32)
         last_out = np.zeros(3, np.float32)
         last_state = 0
         last_quiet = 0
-        for j in range(ny):
-            y = origin[1] + cell * (j + 0.5)
-            z0 = origin[2] + 0.5 * cell
+        for n in range(i * slice_cells, (i + 1) * slice_cells):
+            b_occupied = 1.0
+            b_empty = 1.0
+            covered = False
+            seen = False
+            code = 1 if use_quiet else 0
+            power = 1
             for c in range(num_cameras):
-                for r in range(3):
-                    column[c, r] = (rotations[c, r, 0] * x + rotations[c, r, 1] * y + rotations[c, r, 2] * z0
-                                    + translations[c, r])
-            for k in range(nz):
-                n = (i * ny + j) * nz + k
-                b_occupied = 1.0
-                b_empty = 1.0
-                covered = False
-                seen = False
-                code = 1 if use_quiet else 0
-                power = 1
-                for c in range(num_cameras):
-                    xc = column[c, 0] + k * cell * rotations[c, 0, 2]
-                    yc = column[c, 1] + k * cell * rotations[c, 1, 2]
-                    depth_l = column[c, 2] + k * cell * rotations[c, 2, 2]
-                    power_c = power
-                    power *= 4
-                    if depth_l <= 0.0:
-                        continue
-                    inverse = 1.0 / depth_l
-                    u = math.floor(intrinsics[c, 0] * xc * inverse + intrinsics[c, 2] + 0.5)
-                    v = math.floor(intrinsics[c, 1] * yc * inverse + intrinsics[c, 3] + 0.5)
-                    if u < 0 or u >= sizes[c, 0] or v < 0 or v >= sizes[c, 1]:
-                        continue
-                    d = depth[offsets[c] + int(v) * sizes[c, 0] + int(u)]
-                    if not (d > 0.0 and d < np.inf):
-                        continue
-                    covered = True
-                    width = tail_width * sigma_lut[c, min(int(depth_l * lut_scale), lut_last)]
-                    f, kind = observation(d - depth_l, half_extents[c], width, p_occ, p_free)
-                    if kind != BEHIND:
-                        seen = True
-                    if kind == TAIL:
-                        code = 0
-                    elif code > 0:
-                        code += kind * power_c
-                    b_occupied *= f
-                    b_empty *= 1.0 - f
-                held_here = use_hold and hold[n]
-                if code > 0 and not held_here and quiet[n] == code:
-                    continue  # the step would change nothing
-                q_o = probabilities[n, 0]
-                q_m = probabilities[n, 1]
-                q_e = probabilities[n, 2]
-                if (code > 0 and not held_here and code == last_code and q_o == last_in[0] and q_m == last_in[1]
-                        and q_e == last_in[2]):  # the same step as the last one (cells never seen): its result
-                    probabilities[n, 0] = last_out[0]
-                    probabilities[n, 1] = last_out[1]
-                    probabilities[n, 2] = last_out[2]
-                    states[n] = last_state
-                    visibility[n] = VISIBLE if seen else (HIDDEN if covered else UNOBSERVED)
-                    quiet[n] = last_quiet
+                pixel = pixels[n, c]
+                power_c = power
+                power *= 4
+                if pixel < 0:
                     continue
-                stepped += 1
-                # forward step: Q_t ~ (Q_{t-1}^T A) o B_t
-                o_o, o_e = t_oo, t_oe
-                if not seen and q_o >= q_m and q_o >= q_e:  # static and unseen: it stays
-                    o_o, o_e = 1.0, 0.0
-                m_o, m_m, m_e = t_mo, t_mm, t_me  # the M row: the only one a hold changes
-                if held_here:
-                    m_o, m_m, m_e = h_mo, h_mm, h_me
-                    if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
-                        q_m += q_o
-                        q_o = 0.0
-                r_o = (q_o * o_o + q_m * m_o + q_e * t_eo) * b_occupied
-                r_m = (q_o * t_om + q_m * m_m + q_e * t_em) * b_occupied
-                r_e = (q_o * o_e + q_m * m_e + q_e * t_ee) * b_empty
-                scale = 1.0 / (r_o + r_m + r_e)
-                r_o *= scale
-                r_m *= scale
-                r_e *= scale
-                if r_o < flush:
-                    r_o = 0.0
-                if r_m < flush:
-                    r_m = 0.0
-                if r_e < flush:
-                    r_e = 0.0
-                s_o, s_m, s_e = np.float32(r_o), np.float32(r_m), np.float32(r_e)
-                unchanged = s_o == probabilities[n, 0] and s_m == probabilities[n, 1] and s_e == probabilities[n, 2]
-                quiet[n] = code if unchanged and not held_here else 0
-                probabilities[n, 0] = s_o
-                probabilities[n, 1] = s_m
-                probabilities[n, 2] = s_e
-                if r_o >= r_m and r_o >= r_e:
-                    states[n] = 0
-                elif r_m >= r_e:
-                    states[n] = 1
-                else:
-                    states[n] = 2
+                d = depth[offsets[c] + pixel]
+                if not (d > 0.0 and d < np.inf):
+                    continue
+                covered = True
+                f, kind = observation(d - depths_l[n, c], half_extents[c], widths[n, c], p_occ, p_free)
+                if kind != BEHIND:
+                    seen = True
+                if kind == TAIL:
+                    code = 0
+                elif code > 0:
+                    code += kind * power_c
+                b_occupied *= f
+                b_empty *= 1.0 - f
+            held_here = use_hold and hold[n]
+            if code > 0 and not held_here and quiet[n] == code:
+                continue  # the step would change nothing
+            q_o = probabilities[n, 0]
+            q_m = probabilities[n, 1]
+            q_e = probabilities[n, 2]
+            if (code > 0 and not held_here and code == last_code and q_o == last_in[0] and q_m == last_in[1]
+                    and q_e == last_in[2]):  # the same step as the last one (cells never seen): its result
+                probabilities[n, 0] = last_out[0]
+                probabilities[n, 1] = last_out[1]
+                probabilities[n, 2] = last_out[2]
+                states[n] = last_state
                 visibility[n] = VISIBLE if seen else (HIDDEN if covered else UNOBSERVED)
-                if code > 0 and not held_here:
-                    last_code = code
-                    last_in[0], last_in[1], last_in[2] = q_o, q_m, q_e
-                    last_out[0], last_out[1], last_out[2] = s_o, s_m, s_e
-                    last_state = states[n]
-                    last_quiet = quiet[n]
+                quiet[n] = last_quiet
+                continue
+            stepped += 1
+            # forward step: Q_t ~ (Q_{t-1}^T A) o B_t
+            o_o, o_e = t_oo, t_oe
+            if not seen and q_o >= q_m and q_o >= q_e:  # static and unseen: it stays
+                o_o, o_e = 1.0, 0.0
+            m_o, m_m, m_e = t_mo, t_mm, t_me  # the M row: the only one a hold changes
+            if held_here:
+                m_o, m_m, m_e = h_mo, h_mm, h_me
+                if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
+                    q_m += q_o
+                    q_o = 0.0
+            r_o = (q_o * o_o + q_m * m_o + q_e * t_eo) * b_occupied
+            r_m = (q_o * t_om + q_m * m_m + q_e * t_em) * b_occupied
+            r_e = (q_o * o_e + q_m * m_e + q_e * t_ee) * b_empty
+            scale = 1.0 / (r_o + r_m + r_e)
+            r_o *= scale
+            r_m *= scale
+            r_e *= scale
+            if r_o < flush:
+                r_o = 0.0
+            if r_m < flush:
+                r_m = 0.0
+            if r_e < flush:
+                r_e = 0.0
+            s_o, s_m, s_e = np.float32(r_o), np.float32(r_m), np.float32(r_e)
+            unchanged = s_o == probabilities[n, 0] and s_m == probabilities[n, 1] and s_e == probabilities[n, 2]
+            quiet[n] = code if unchanged and not held_here else 0
+            probabilities[n, 0] = s_o
+            probabilities[n, 1] = s_m
+            probabilities[n, 2] = s_e
+            if r_o >= r_m and r_o >= r_e:
+                states[n] = 0
+            elif r_m >= r_e:
+                states[n] = 1
+            else:
+                states[n] = 2
+            visibility[n] = VISIBLE if seen else (HIDDEN if covered else UNOBSERVED)
+            if code > 0 and not held_here:
+                last_code = code
+                last_in[0], last_in[1], last_in[2] = q_o, q_m, q_e
+                last_out[0], last_out[1], last_out[2] = s_o, s_m, s_e
+                last_state = states[n]
+                last_quiet = quiet[n]
     return stepped
 
 

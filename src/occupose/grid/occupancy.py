@@ -2,9 +2,10 @@
 
 Every cell of a :class:`~occupose.grid.spec.GridSpec` runs a hidden Markov model with the
 states of the first paper (section III-A): ``O`` occupied by a static object, ``M``
-occupied by a moving object, ``E`` empty. Each frame, the cell centre is projected into
-every depth image; with ``l`` the centre's depth along that camera's optical axis and
-``d`` the measured depth at its pixel, ``epsilon = d - l`` gives the observation function
+occupied by a moving object, ``E`` empty. Each frame, every depth image is read at the
+pixel the cell centre projects to (found once, when the grid is made: the cameras do not
+move); with ``l`` the centre's depth along that camera's optical axis and ``d`` the
+measured depth at its pixel, ``epsilon = d - l`` gives the observation function
 (the paper's Fig. 3, :func:`observation_function`), a plateau as wide as the cell with
 edges blurred by the sensor's depth noise::
 
@@ -131,10 +132,16 @@ INITIAL = GridConfig.initial
 DEFAULT_NOISE_MODEL = "structured_light"
 #: Far range (metres) for cameras whose intrinsics match no sensor preset.
 DEFAULT_MAX_RANGE = 4.5
-#: Peak bytes per cell while a grid is made and updated (measured on no_occlusion's grid at
-#: 0.4, 1.9 and 6.5 M cells: 71 B; the coverage check's cell centres and their projections
-#: dominate): the memory estimate of :func:`spec_from_cameras`'s ``max_cells``.
+#: Peak bytes per cell while a grid is made, whatever the number of cameras: the coverage
+#: check's cell centres and their projections, freed before the grid's own arrays are made
+#: (tracemalloc: 72.0 B on no_occlusion's grid at 0.4, 1.9 and 6.5 M cells and on
+#: two_cameras_occlusion's at 0.7 and 3.3 M; docs/notes/2026-12-06-grid-projection-tables.md).
 BYTES_PER_CELL = 72
+#: Bytes per cell an :class:`OccupancyGrid` keeps: the (O, M, E) beliefs (3 float32), the
+#: state, the visibility and the kernel's skip code (uint16).
+GRID_BYTES_PER_CELL = 16
+#: ... and per cell and camera: the cell centre's pixel (int32), depth and tail width (float64).
+TABLE_BYTES_PER_CELL = 20
 #: Posterior probabilities below this are set to 0 (float32 never goes subnormal).
 FLUSH = 1e-30
 _LUT_STEP = 0.01
@@ -322,7 +329,7 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
         is not used)
     max_cells : None, or the most cells the grid may have (``limits.grid_cells``): a larger
         grid is refused before anything is allocated, with its size and memory
-        (:data:`BYTES_PER_CELL`)
+        (:func:`bytes_per_cell` of the number of cameras)
     Returns the GridSpec covering the bounding box of the cameras' view pyramids clipped
     to 0 <= z <= height (or ``bounds``), extended down to z = -cell / 2 so that the bottom
     layer of cells is centred on the floor: the cell centres' rays then meet the floor
@@ -337,7 +344,7 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
     far = _max_ranges(cameras, max_range)
     if bounds is not None:
         low, high = (np.asarray(b, np.float64) for b in bounds)
-        _check_size(low, high, cell, max_cells)
+        _check_size(low, high, cell, max_cells, len(cameras))
         spec = GridSpec.from_bounds(low, high, cell)
     else:
         if not (isinstance(height, (int, float, np.floating)) and math.isfinite(height) and height > 0):
@@ -354,24 +361,33 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
         low = points.min(axis=0)
         low[2] = -0.5 * cell  # the bottom layer is centred on the floor
         high = points.max(axis=0)
-        _check_size(low, high, cell, max_cells)
+        _check_size(low, high, cell, max_cells, len(cameras))
         spec = GridSpec.from_bounds(low, high, cell)
     _check_coverage(spec, cameras, far)
     return spec
 
 
-def _check_size(low: np.ndarray, high: np.ndarray, cell: float, max_cells: int | None) -> None:
-    """ValueError with the grid's size and memory when the box from ``low`` to ``high``
-    (metres) holds more than ``max_cells`` cells of ``cell`` metres (counted in floats: no
-    overflow, nothing allocated)."""
+def bytes_per_cell(num_cameras: int) -> int:
+    """Peak bytes per cell of making and updating a grid seen by ``num_cameras`` cameras:
+    the larger of the coverage check's :data:`BYTES_PER_CELL` and what the grid keeps,
+    :data:`GRID_BYTES_PER_CELL` + :data:`TABLE_BYTES_PER_CELL` per camera (72 B up to two
+    cameras, 76 B for three, 96 B for four; each camera's image adds 4 bytes a pixel)."""
+    return max(BYTES_PER_CELL, GRID_BYTES_PER_CELL + TABLE_BYTES_PER_CELL * int(num_cameras))
+
+
+def _check_size(low: np.ndarray, high: np.ndarray, cell: float, max_cells: int | None, num_cameras: int) -> None:
+    """ValueError with the grid's size and memory (:func:`bytes_per_cell`) when the box from
+    ``low`` to ``high`` (metres) holds more than ``max_cells`` cells of ``cell`` metres
+    (counted in floats: no overflow, nothing allocated)."""
     counts = np.ceil((np.asarray(high) - np.asarray(low)) / cell - 1e-9)
     cells = float(np.prod(counts))
     if max_cells is not None and cells > max_cells:
+        per_cell = bytes_per_cell(num_cameras)
         raise ValueError(f"grid.cell = {cell:g} m gives a grid of {' x '.join(f'{c:.0f}' for c in counts)} = "
                          f"{cells:.3g} cells over the cameras' view "
                          f"({' x '.join(f'{v:.3g}' for v in np.asarray(high) - low)} m), about "
-                         f"{cells * BYTES_PER_CELL / 1e9:.3g} GB; the bound limits.grid_cells is {max_cells:,} cells "
-                         f"(about {max_cells * BYTES_PER_CELL / 1e9:.2g} GB): use a larger grid.cell, or a shorter "
+                         f"{cells * per_cell / 1e9:.3g} GB; the bound limits.grid_cells is {max_cells:,} cells "
+                         f"(about {max_cells * per_cell / 1e9:.2g} GB): use a larger grid.cell, or a shorter "
                          f"grid.max_range or grid.height")
 
 
@@ -482,12 +498,14 @@ class OccupancyGrid:
         self.stepped = 0
 
     def _camera_arrays(self) -> None:
-        """Per-camera arrays of the kernel (module docstring of occupose.grid._kernels)."""
+        """Per-camera arrays of the kernel, and where every cell centre falls in every image
+        (module docstring of occupose.grid._kernels): the cameras do not move, so each cell's
+        pixel, depth and tail width are found once, here."""
         count = len(self.cameras)
-        self._rotations = np.empty((count, 3, 3))
-        self._translations = np.empty((count, 3))
-        self._intrinsics = np.empty((count, 4))
-        self._sizes = np.empty((count, 2), np.int64)
+        rotations = np.empty((count, 3, 3))
+        translations = np.empty((count, 3))
+        intrinsics = np.empty((count, 4))
+        sizes = np.empty((count, 2), np.int64)
         self._offsets = np.zeros(count, np.int64)
         self._half_extents = np.empty(count)
         lut_depths = np.arange(int(round(_LUT_DEPTH / _LUT_STEP)) + 1) * _LUT_STEP
@@ -495,10 +513,10 @@ class OccupancyGrid:
         offset = 0
         for c, cam in enumerate(self.cameras):
             pose = cam.camera_from_world
-            self._rotations[c] = pose[:3, :3]
-            self._translations[c] = pose[:3, 3]
-            self._intrinsics[c] = (cam.fx, cam.fy, cam.cx, cam.cy)
-            self._sizes[c] = (cam.width, cam.height)
+            rotations[c] = pose[:3, :3]
+            translations[c] = pose[:3, 3]
+            intrinsics[c] = (cam.fx, cam.fy, cam.cx, cam.cy)
+            sizes[c] = (cam.width, cam.height)
             self._offsets[c] = offset
             offset += cam.width * cam.height
             self._half_extents[c] = 0.5 * self.spec.cell * np.abs(pose[2, :3]).sum()
@@ -506,6 +524,15 @@ class OccupancyGrid:
             measured = isinstance(model, NoiseEstimate)
             self._sigma_lut[c] = model.std(lut_depths) if measured else depth_std(lut_depths, model)
         self._depth = np.empty(offset, np.float32)
+        num_cells = self.spec.num_cells
+        #: (N, C) each cell centre's flat pixel index in each image (-1: none), its depth along
+        #: the optical axis (metres) and the observation function's tail width there (metres).
+        self._pixels = np.empty((num_cells, count), np.int32)
+        self._depths_l = np.empty((num_cells, count))
+        self._widths = np.empty((num_cells, count))
+        _kernels.pixels_from_cells(np.asarray(self.spec.origin), self.spec.cell, *self.spec.shape, rotations,
+                                   translations, intrinsics, sizes, self._sigma_lut, _LUT_STEP, self.tail_width,
+                                   self._pixels, self._depths_l, self._widths)
 
     def depth_noise(self, depth_l, camera: str) -> np.ndarray:
         """The depth noise (one standard deviation, metres) the grid assumes for camera ``camera``
@@ -561,7 +588,8 @@ class OccupancyGrid:
             cell in its parallel loop.
 
         Runs one fused numba kernel over all cells (it releases the GIL, so another thread
-        can work meanwhile). A cell's HMM step is skipped where it would change nothing: the
+        can work meanwhile); it reads each cell centre's pixel, depth and tail width per
+        camera from tables made with the grid (20 bytes per cell and camera). A cell's HMM step is skipped where it would change nothing: the
         cell is not held, its last step left its probabilities bit for bit as they were, and
         every camera observes it as then with the same value of the observation function
         (seen through beyond the tails, on the surface, hidden beyond the tails, or not
@@ -578,13 +606,10 @@ class OccupancyGrid:
                 raise ValueError(f"hold must be a bool array of the grid's shape {self.spec.shape}, "
                                  f"got {hold.dtype} {hold.shape}")
             hold = np.ascontiguousarray(hold).reshape(-1)
-        nx, ny, nz = self.spec.shape
         self.stepped = _kernels.update_grid(
-            np.asarray(self.spec.origin), self.spec.cell, nx, ny, nz, self._rotations, self._translations,
-            self._intrinsics, self._sizes, self._offsets, self._depth, self._sigma_lut, _LUT_STEP,
-            self._half_extents, self.tail_width, self.p_occ, self.p_free, self.transition, self.held_transition,
-            hold, FLUSH, self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1),
-            self._quiet,
+            self.spec.shape[0], self._pixels, self._depths_l, self._widths, self._offsets, self._depth,
+            self._half_extents, self.p_occ, self.p_free, self.transition, self.held_transition, hold, FLUSH,
+            self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1), self._quiet,
         )
         self.num_updates += 1
 
