@@ -477,7 +477,7 @@ def track_cmd(recording, out, method, model, filter_name, likelihood, particles,
 @click.argument("images", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--camera", "camera_option", required=True, metavar="PRESET|FILE.json",
               help="The camera: a preset (kinect_v1, kinect_v2, azure_nfov, realsense_d435) or a JSON file of width, "
-              "height, fx, fy, cx, cy and optionally world_from_camera (docs/inputs.md).")
+              "height, fx, fy, cx, cy and optionally world_from_camera (docs/outputs.md, single frames).")
 @click.option("--out", type=click.Path(path_type=Path), required=True,
               help="Folder for tracks.csv, summary.json and a picture per image.")
 @click.option("--model", type=click.Choice(["auto", "full", "upper"]), default="auto", show_default=True,
