@@ -88,8 +88,9 @@ def _match(fitted: np.ndarray, truth: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(rows.tolist(), cols.tolist()))
 
 
-def score_scene(seed: int, config="ours") -> list[dict]:
-    """Every person-frame record of scene ``seed``'s four fits (module docstring) with ``config``."""
+def score_scene(seed: int, config="ours", fit_seed: int = 0) -> list[dict]:
+    """Every person-frame record of scene ``seed``'s four fits (module docstring) with
+    ``config``, the fits seeded with ``fit_seed``."""
     scenario, frame, background = _frame(seed)
     camera = scenario.cameras[0]
     depth = frame.depth[camera.name]
@@ -104,7 +105,7 @@ def score_scene(seed: int, config="ours") -> list[dict]:
         for pose in POSES:
             start = time.perf_counter()
             fit = fit_frame(depth if kind == "background" else removed, camera, world=pose == "given",
-                            background=background if kind == "background" else None, config=config, seed=0)
+                            background=background if kind == "background" else None, config=config, seed=fit_seed)
             seconds = time.perf_counter() - start
             truth = frame.joints[shown]
             if fit.frame == "camera":
@@ -159,10 +160,10 @@ def table(records: list[dict]) -> list[dict]:
     return rows
 
 
-def measure(seeds, progress: bool = False, config="ours") -> list[dict]:
+def measure(seeds, progress: bool = False, config="ours", fit_seed: int = 0) -> list[dict]:
     records = []
     for seed in tqdm(list(seeds), desc="fit benchmark", unit="scene", disable=not progress):
-        records += score_scene(seed, config)
+        records += score_scene(seed, config, fit_seed)
     return records
 
 
@@ -176,14 +177,16 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=RESULTS)
     parser.add_argument("--set", dest="assignments", action="append", default=[], metavar="KEY=VALUE",
                         help="a setting of the fit, e.g. fit.steps=10 (repeatable), for an A/B in the same run")
+    parser.add_argument("--seed", type=int, default=0, help="the fits' seed (the scenes stay the same)")
     args = parser.parse_args()
     values = {key: json.loads(value) for key, _, value in (a.partition("=") for a in args.assignments)}
-    records = measure(range(args.scenes), progress=True, config=as_config("ours").with_values(values))
+    records = measure(range(args.scenes), progress=True, config=as_config("ours").with_values(values),
+                      fit_seed=args.seed)
     rows = table(records)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "fit.json").write_text(json.dumps(records, indent=1) + "\n")
     cells = [[f"{v:.2f}" if isinstance(v, float) else str(v) for v in row.values()] for row in rows]
-    text = f"### {TITLE}\n\n{args.scenes} scenes, settings {values or 'ours'}\n\n" + markdown_table(list(rows[0]), cells)
+    text = f"### {TITLE}\n\n{args.scenes} scenes, settings {values or 'ours'}, fit seed {args.seed}\n\n" + markdown_table(list(rows[0]), cells)
     (args.out / "fit.md").write_text(text)
     print(text)
 

@@ -96,6 +96,17 @@ def test_fit_in_the_camera_frame_pictures_each_image_and_refuses_to_overwrite(im
     assert CliRunner().invoke(main, [*args, "--force"]).exit_code == 0
 
 
+def test_an_image_of_the_empty_scene_has_nobody_and_says_so(images, tmp_path):
+    folder, _, _ = images
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["fit", str(folder / "empty.png"), "--camera", str(folder / "camera.json"),
+                                       "--background", str(folder / "empty.png"), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "0 person(s) in 1 image(s)" in result.output and "nobody was found" in result.output
+    assert read_joint_table(out / "tracks.csv", 1, "tracks") == {}
+    assert json.loads((out / "summary.json").read_text())["frames"][0]["people"] == []
+
+
 def test_reading_depth_images_and_cameras(images, tmp_path):
     folder, camera, _ = images
     png = read_depth_image(folder / "person.png", camera)

@@ -516,6 +516,9 @@ def fit_cmd(images, camera_option, out, model, depth_scale, background, seed, co
     seconds = sum(frame["seconds"] for frame in summary["frames"])
     click.echo(f"{summary['people']} person(s) in {summary['images']} image(s), {seconds / summary['images']:.2f} s "
                f"per image, coordinates in the {summary['frame']} frame -> {out / 'tracks.csv'}")
+    if not summary["people"]:
+        click.echo(f"nobody was found: no group of at least {config.fit.min_points} points and {config.fit.min_height} m "
+                   f"tall{'' if background else ' (without --background every measured pixel counts)'}")
 
 
 @main.command("batch")
