@@ -60,6 +60,7 @@ def test_fit_writes_tracks_pictures_and_summary_in_the_world_given(images, tmp_p
     np.testing.assert_allclose(tracks[1][0][0], tracks[2][0][1], atol=2e-6)  # PNG and raw: the same image
     summary = json.loads((out / "summary.json").read_text())
     assert summary["frame"] == "world" and summary["images"] == 2 and summary["people"] == 2
+    assert summary["config"]["fit"]["steps"] == 15 and summary["config"]["pose"]["particles"] > 0
     assert [f["picture"] for f in summary["frames"]] == ["person.png", "person_raw.png"]
     assert summary["frames"][0]["people"][0]["model"] == "full" and summary["frames"][0]["floor"] is None
 

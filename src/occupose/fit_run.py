@@ -10,9 +10,9 @@ seed: an image gives the same fit alone as among others). The output folder hold
   world pose was given;
 - ``<image name>.png`` per image: the depth colour-mapped with the skeletons drawn (hidden
   joints as crosses, bones to them dashed);
-- ``summary.json``: the frame of the coordinates, the camera, and per image its people
-  (track, body model, stature measured or taken, points, visible joints), the floor
-  found in it (camera height and tilt) and the seconds its fit took.
+- ``summary.json``: the frame of the coordinates, the whole resolved config, the camera,
+  and per image its people (track, body model, stature measured or taken, points, visible
+  joints), the floor found in it (camera height and tilt) and the seconds its fit took.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from occupose.camera import Camera
-from occupose.config import TrackerConfig
+from occupose.config import TrackerConfig, as_config
 from occupose.io.depth_image import read_depth_image
 from occupose.io.joint_table import write_tracks_csv
 from occupose.io.output import SOFTWARE, staged_folder, write_text
@@ -61,6 +61,7 @@ def fit_into(out: str | os.PathLike, paths: Sequence[str | os.PathLike], camera:
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; valid: {', '.join(MODELS)}")
     names = picture_names(paths)
+    config = as_config(config)
     empty = None if background is None else read_depth_image(background, camera, depth_scale)
     inputs = [*paths, *([] if background is None else [background])]
     drawn = camera if world else dataclasses.replace(camera, world_from_camera=np.eye(4))
@@ -80,7 +81,7 @@ def fit_into(out: str | os.PathLike, paths: Sequence[str | os.PathLike], camera:
                 progress(1)
         write_tracks_csv(folder / "tracks.csv", _joint_table(tracks, len(paths)))
         summary = {"command": "fit", "frame": "world" if world else "camera", "model": model, "seed": seed,
-                   "camera": camera.to_dict(), "background": None if background is None else str(background),
+                   "config": config.to_dict(), "camera": camera.to_dict(), "background": None if background is None else str(background),
                    "images": len(paths), "people": len(tracks), "frames": frames}
         write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary

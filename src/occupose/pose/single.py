@@ -51,7 +51,7 @@ from scipy.spatial import cKDTree
 from occupose.body import body_model, dims_from_observation
 from occupose.body.dims import DEFAULT_DIMS
 from occupose.body.kinematics import joints_from_pose
-from occupose.body.size import breadth_profile, dims_with_shoulders, neck_and_shoulders
+from occupose.body.size import breadth_profile, dims_with_shoulders, neck_and_shoulders, top_height
 from occupose.camera import Camera, pixels_from_points, points_from_depth
 from occupose.config import TrackerConfig, as_config
 from occupose.geometry.floor import Floor, fit_floor
@@ -169,13 +169,14 @@ def fit_frame(depth, camera: Camera, *, model: str = "auto", world: bool = False
         points, pixels = points[keep], pixels[keep]
     groups = people_of_points(points, groups_of_points(points, fit.join_m), config)
     rng = np.random.default_rng(seed)
+    camera_from_world = placed.camera_from_world
     people = []
     for group in range(int(groups.max(initial=-1)) + 1):
         own = groups == group
         person = _fit_person(points[own], pixels[own], depth, placed, floor_known, model, config,
                              np.random.default_rng(rng.integers(2**63)))
         if not world:
-            joints = person.joints @ np.linalg.inv(pose)[:3, :3].T + np.linalg.inv(pose)[:3, 3]
+            joints = person.joints @ camera_from_world[:3, :3].T + camera_from_world[:3, 3]
             person = person._replace(joints=joints)
         people.append(person)
     people.sort(key=lambda p: float(np.mean(p.pixels % camera.width)))
@@ -236,8 +237,7 @@ def _fit_person(points: np.ndarray, pixels: np.ndarray, depth: np.ndarray, camer
     else:
         dims, girth = DEFAULT_DIMS.scaled(fit.stature), 1.0
         if not floor_known:  # the person stands on a floor of their own, their top at the stature
-            top = np.partition(points[:, 2], len(points) - config.size.top_rank)[len(points) - config.size.top_rank]
-            offset[2] = dims.height - config.size.top_bias - top
+            offset[2] = dims.height - config.size.top_bias - top_height(points[:, 2], config.size.top_rank)
     points = points + offset
     shape = neck_and_shoulders(breadth_profile(points, config.size), config.size)
     if shape is not None:
