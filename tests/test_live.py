@@ -19,7 +19,9 @@ from occupose.synth.generate import frames
 from occupose.synth.scenarios import build_scenario
 from occupose.testing import write_depth_bag
 
-pytest.importorskip("pyrealsense2", reason="the realsense extra (pyrealsense2, with Debian's libusb-1.0-0)")
+# ImportError, not only ModuleNotFoundError: pyrealsense2 installed without Debian's libusb-1.0-0 fails to load
+pytest.importorskip("pyrealsense2", reason="the realsense extra (pyrealsense2, with Debian's libusb-1.0-0)",
+                    exc_type=ImportError)
 
 from occupose.live import RealSenseCamera, track_live  # noqa: E402
 
