@@ -38,6 +38,8 @@ CAMERA_NAME = "depth"
 FRAME_TIMEOUT_MS = 2000
 #: Seconds between status lines.
 STATUS_EVERY_S = 1.0
+#: Frames the camera's queue holds until they are taken (the oldest go first when it is full).
+QUEUE_FRAMES = 64
 
 
 @dataclass(frozen=True)
@@ -75,8 +77,11 @@ class RealSenseCamera:
         config.enable_stream(rs.stream.depth)
         self._rs = rs
         self._pipeline = rs.pipeline()
+        # Every frame delivered goes to a queue of ours: the pipeline's own holds only the newest, so a
+        # bag's first frames, played before it could be paused, would be lost on a busy machine.
+        self._queue = rs.frame_queue(QUEUE_FRAMES, keep_frames=True)
         try:
-            profile = self._pipeline.start(config)
+            profile = self._pipeline.start(config, self._queue)
         except RuntimeError as error:
             what = f"{bag}: not a RealSense recording it can play" if bag is not None else "no RealSense camera"
             raise ValueError(f"{what} ({error})") from None
@@ -93,20 +98,20 @@ class RealSenseCamera:
         self._last = None
 
     def frames(self) -> Iterator[LiveFrame]:
-        """The newest frame each time one is asked for (the first: the first the camera
-        delivered, from which drops are counted), until none comes for
+        """The newest frame each time one is asked for, from which drops are counted (the
+        first from a bag: the first it played), until none comes for
         :data:`FRAME_TIMEOUT_MS` (a bag played to its end, a camera unplugged)."""
         self.resume()
         while True:
-            ok, frames = self._pipeline.try_wait_for_frames(FRAME_TIMEOUT_MS)
+            ok, frame = self._queue.try_wait_for_frame(FRAME_TIMEOUT_MS)
             if not ok:
                 return
-            while self._last is not None:  # those that came while the last one was tracked: the newest
-                newer = self._pipeline.poll_for_frames()
+            while self._last is not None or self._playback is None:  # those that came meanwhile: the newest
+                newer = self._queue.poll_for_frame()
                 if not newer:
                     break
-                frames = newer
-            depth = frames.get_depth_frame()
+                frame = newer
+            depth = frame.as_frameset().get_depth_frame() if frame.is_frameset() else frame.as_depth_frame()
             number = int(depth.get_frame_number())
             dropped = 0 if self._last is None else max(number - self._last - 1, 0)
             self._last = number
