@@ -186,6 +186,9 @@ class GridConfig(_Section):
     tail_width: float = setting(2.0, "width of the observation function's tails", "sensor depth std", low=0)
     initial: tuple[float, float, float] = setting((0.4, 0.0, 0.6), "initial distribution over (O, M, E)",
                                                   "probability", low=0, high=1)
+    no_return: float = setting(1.0, "factor on a static object's likelihood in a cell in front of a pixel that "
+                                    "measured nothing, nearer than the camera's far range (1: no evidence, "
+                                    "the paper's model)", "likelihood ratio", above=0, high=1)
     hold_people: bool = setting(True, "hold the cells of the people estimated in the last frame as moving, so a "
                                       "person standing still is not absorbed into the background")
     hold_margin: float = setting(0.1, "margin around each body capsule of the held cells", "m", low=0)

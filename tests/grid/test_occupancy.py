@@ -35,11 +35,13 @@ def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarra
     """One frame of the grid in plain NumPy: (probabilities (N, 3) float64, states (N,), visibility (N,)).
     hold : optional (N,) bool, cells stepped with psi = 0 (the M row renormalised), their O
         share moved to M first where their MAP state is M. Cells no camera sees whose MAP
-        state is O step with alpha = 0."""
+        state is O step with alpha = 0. O's likelihood takes grid.no_return per camera whose
+        pixel measured nothing nearer than its far range, unless the cell's MAP state is O."""
     centres = grid.spec.centers().reshape(-1, 3)
     likelihood = np.ones((len(centres), 3))
     covered = np.zeros(len(centres), bool)
     seen = np.zeros(len(centres), bool)
+    no_return = np.ones(len(centres))
     for cam in grid.cameras:
         uv, depth_l = pixels_from_points(centres, cam)
         with np.errstate(invalid="ignore"):
@@ -54,6 +56,7 @@ def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarra
         epsilon = np.where(valid, d - depth_l, np.nan)
         f = observation_function(epsilon, grid.half_extent(cam.name), width, grid.p_occ, grid.p_free)
         likelihood *= np.column_stack([f, f, 1.0 - f])
+        no_return[inside & ~valid & (depth_l <= grid.max_ranges[cam.name])] *= grid.no_return
         covered |= valid
         with np.errstate(invalid="ignore"):
             seen |= valid & (epsilon >= -band)
@@ -71,6 +74,8 @@ def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarra
             prior[moving, M] += prior[moving, O]
             prior[moving, O] = 0.0
             q[where] = prior @ held
+    static = (probabilities[:, O] >= probabilities[:, M]) & (probabilities[:, O] >= probabilities[:, E])
+    likelihood[:, O] *= np.where(static, 1.0, no_return)
     q *= likelihood
     q /= q.sum(axis=1, keepdims=True)
     q[q < FLUSH] = 0.0
@@ -215,6 +220,23 @@ def test_update_kernel_matches_numpy(rng):
     assert set(np.unique(states)) == {O, M, E} and set(np.unique(visibility)) == {UNOBSERVED, VISIBLE, HIDDEN}
     counts = np.bincount(grid.states.reshape(-1), minlength=3)
     assert counts.min() > 50
+
+
+def test_update_kernel_with_no_return_matches_numpy(rng):
+    grid, depths = random_setup(rng)
+    grid = OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, p_free=0.08, no_return=0.5, max_range=4.0)
+    grid._probabilities[...] = rng.dirichlet((0.5, 0.5, 0.5), grid.spec.shape).astype(np.float32)
+    plain = reference_update(OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, p_free=0.08, max_range=4.0),
+                             depths, grid.probabilities.reshape(-1, 3))[0]
+    expected = grid.probabilities.reshape(-1, 3).astype(np.float64)
+    for _ in range(3):
+        expected = reference_update(grid, depths, expected.astype(np.float32))[0]
+        grid.update(depths)
+        if _ == 0:  # the factor changed the cells in front of the holes, not being static
+            assert (np.abs(expected - plain).max(axis=1) > 1e-3).sum() > 100
+    np.testing.assert_allclose(grid.probabilities.reshape(-1, 3), expected, atol=1e-6, rtol=0)
+    with pytest.raises(ValueError, match="no_return must be in"):
+        OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, no_return=0.0)
 
 
 def test_update_kernel_matches_numpy_over_frames(rng):
@@ -418,6 +440,29 @@ def test_person_present_at_the_first_frame_is_extracted():
     assert np.mean(ious[20:]) >= 0.9
 
 
+def test_a_person_walking_before_a_background_beyond_range_is_moving(walk):
+    """no_occlusion with its rear wall taken out of the images (depth 0, as a wall beyond the
+    sensor's range gives): the cells in front of it never get a reading. A missing reading
+    nearer than the far range counts against a static object there (no_return < 1), so
+    where the person walks they are moving; with the paper's model (1) they keep the initial
+    O share and are static at once."""
+    scenario, rendered = walk
+    cam = scenario.cameras[0]
+    spec = spec_from_cameras(scenario.cameras)
+    ious = {}
+    for no_return in (0.5, 1.0):
+        grid = OccupancyGrid(spec, scenario.cameras, no_return=no_return)
+        scores = []
+        for frame in rendered:
+            depth = frame.depth[cam.name].copy()
+            person = frame.rendered[cam.name].person > 0
+            depth[(depth > 3.4) & ~person] = 0.0  # the rear wall (4.2 m), three quarters of the image
+            grid.update({cam.name: depth})
+            scores.append(foreground_scores(foreground_from_grid(grid.states, spec, depth, cam), person)[2])
+        ious[no_return] = np.mean(scores[20:])
+    assert ious[0.5] > 0.9 and ious[1.0] < 0.5  # measured: 0.97 and 0.26
+
+
 def chair_pixels(scenario, frame, cam) -> np.ndarray:
     """(H, W) bool: pixels where the moved chair is the nearest surface."""
     rendered = frame.rendered[cam.name]
@@ -570,11 +615,13 @@ def test_skipped_steps_equal_the_full_update_on_a_rendered_walk(walk):
     assert max(stepped[-10:]) < 0.25 * spec.num_cells  # measured: 18 % (a person's noisy surroundings)
 
 
-def test_skipped_steps_equal_the_full_update_with_two_cameras(rng):
+@pytest.mark.parametrize("no_return", [1.0, 0.5])
+def test_skipped_steps_equal_the_full_update_with_two_cameras(rng, no_return):
     """Two random cameras with holes and NaN in their depth: a scene that stays the same for
-    50 frames settles most cells (skipped), then changes; the beliefs follow the reference."""
+    50 frames settles most cells (skipped), then changes; the beliefs follow the reference
+    (also where the holes are evidence against static cells, no_return < 1)."""
     grid, depths = random_setup(rng, num_cameras=2)
-    grid._probabilities[...] = grid.initial
+    grid = OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, p_free=0.08, no_return=no_return)
     expected = grid.probabilities.reshape(-1, 3).astype(np.float64)
     for t in range(56):
         if t == 50:

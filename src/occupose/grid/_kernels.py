@@ -44,10 +44,14 @@ HIDDEN = 2
 #: The observation function's Gaussian tails stop at this many tail widths.
 TAIL_CUT = 3.0
 #: Classes of one camera's observation of a cell: no measurement, the three values the
-#: observation function takes exactly (p_free, p_occ, 0.5), and its tails.
-UNCOVERED, SEEN_THROUGH, ON_SURFACE, BEHIND, TAIL = 0, 1, 2, 3, 4
-#: Cameras whose observation classes fit a cell's ``quiet`` code (4 ** 7 < 2 ** 16).
-QUIET_CAMERAS = 7
+#: observation function takes exactly (p_free, p_occ, 0.5), no return within range (the
+#: cell is in front of a pixel that measured nothing, nearer than the camera's far range),
+#: and the observation function's tails.
+UNCOVERED, SEEN_THROUGH, ON_SURFACE, BEHIND, NO_RETURN, TAIL = 0, 1, 2, 3, 4, 5
+#: Observation classes of a quiet code's base (all but TAIL).
+QUIET_BASE = 5
+#: Cameras whose observation classes fit a cell's ``quiet`` code (5 ** 6 < 2 ** 16).
+QUIET_CAMERAS = 6
 
 
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
@@ -119,8 +123,8 @@ def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrins
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
-def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, p_occ, p_free, transition, held, hold,
-                flush, probabilities, states, visibility, quiet):
+def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, fars, p_occ, p_free, no_return,
+                transition, held, hold, flush, probabilities, states, visibility, quiet):
     """One frame of the grid, in place; returns the number of cells whose HMM step ran.
 
     nx : int, the grid's x slices (run in parallel; the N cells are nx slices of N / nx)
@@ -128,15 +132,20 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, p_oc
         cell centre's pixel in each camera's image (-1: none), depth along its optical axis
         and tail width, from :func:`pixels_from_cells`
     offsets (C,) int64; depth (sum H*W,) float32 metres (<= 0 or not finite: no measurement)
-    half_extents (C,) float64 metres
+    half_extents (C,) float64 metres; fars (C,) float64 metres, each camera's far range
     p_occ, p_free : floats of the observation function
+    no_return : float in (0, 1], the factor on O's likelihood per camera whose pixel measured
+        nothing while the cell is nearer than its far range (a static surface there would
+        have returned; M and E are alike, so a person's dropouts cut no holes): class
+        NO_RETURN. A cell whose MAP state is O before the step takes no factor: as for a
+        static cell no camera sees, a missing reading does not remove it
     transition : (3, 3) float64, row = previous state, column = next state
     held : (3, 3) float64, the transition matrix of held cells (only its M row may differ from
         ``transition``); hold : (N,) bool or (0,) bool
     flush : float, posterior probabilities below it are set to 0 (no subnormal floats)
     probabilities : (N, 3) float32 in/out; states, visibility : (N,) uint8 out
-    quiet : (N,) uint16 in/out, 0 or ``1 + sum_c class_c 4^c`` over the cameras' observation
-        classes (UNCOVERED, SEEN_THROUGH, ON_SURFACE, BEHIND) of the cell's last step when
+    quiet : (N,) uint16 in/out, 0 or ``1 + sum_c class_c 5^c`` over the cameras' observation
+        classes (UNCOVERED, SEEN_THROUGH, ON_SURFACE, BEHIND, NO_RETURN) of the cell's last step when
         that step was unheld and left its float32 probabilities bit for bit as they were. The
         step is a function of the probabilities, the classes and the hold alone, so an
         unheld cell whose code matches this frame's classes would give the same result
@@ -164,6 +173,7 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, p_oc
         for n in range(i * slice_cells, (i + 1) * slice_cells):
             b_occupied = 1.0
             b_empty = 1.0
+            b_static = 1.0  # O's likelihood relative to M's (NO_RETURN)
             covered = False
             seen = False
             code = 1 if use_quiet else 0
@@ -171,11 +181,15 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, p_oc
             for c in range(num_cameras):
                 pixel = pixels[n, c]
                 power_c = power
-                power *= 4
+                power *= QUIET_BASE
                 if pixel < 0:
                     continue
                 d = depth[offsets[c] + pixel]
                 if not (d > 0.0 and d < np.inf):
+                    if no_return < 1.0 and depths_l[n, c] <= fars[c]:
+                        b_static *= no_return
+                        if code > 0:
+                            code += NO_RETURN * power_c
                     continue
                 covered = True
                 f, kind = observation(d - depths_l[n, c], half_extents[c], widths[n, c], p_occ, p_free)
@@ -213,7 +227,9 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, p_oc
                 if q_m > q_o and q_m >= q_e:  # MAP M: taken as moving, its O share moves to M
                     q_m += q_o
                     q_o = 0.0
-            r_o = (q_o * o_o + q_m * m_o + q_e * t_eo) * b_occupied
+            if q_o >= q_m and q_o >= q_e:  # static: a missing reading does not remove it (as unseen)
+                b_static = 1.0
+            r_o = (q_o * o_o + q_m * m_o + q_e * t_eo) * b_occupied * b_static
             r_m = (q_o * t_om + q_m * m_m + q_e * t_em) * b_occupied
             r_e = (q_o * o_e + q_m * m_e + q_e * t_ee) * b_empty
             scale = 1.0 / (r_o + r_m + r_e)

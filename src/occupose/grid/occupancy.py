@@ -36,6 +36,23 @@ The states' likelihoods are ``B = (f, f, 1 - f)`` (O and M look alike: the alias
 resolves over time); the likelihoods of several cameras multiply, and a camera that does
 not cover a cell adds nothing.
 
+An option, off by default (``no_return = 1``, the paper's model): a pixel that measures
+nothing (d = 0) while the cell centre is nearer than the camera's far range (``max_range``)
+is evidence against a static surface in the cell, which would have returned a reading:
+its likelihoods are ``B = (no_return, 1, 1)``.
+M keeps 1, as E: a moving person's dropouts (dark hair, a glancing surface) last a frame
+or two and cut no holes. Without it, space in front of a background beyond the sensor's
+range is never observed and keeps the initial distribution's O share, and a person who
+walks into it is static from their first frame there (O wins the first occupied reading,
+since E -> M carries only ``beta`` of E). With ``no_return = 0.5`` the O share of such a
+cell halves every frame, so after ten frames a person walking in is moving, as over a
+floor the camera sees (docs/notes/2026-12-07-never-returned-cells.md). A cell whose MAP
+state is O takes no such factor, as it takes ``alpha = 0`` when no camera sees it: the
+readings of a static surface that come and go (edges in time-of-flight images, walls near
+the range limit) do not turn it into a flickering "moving" layer. On the randomized
+benchmark 0.5 helps the front views before a background beyond range and harms the top
+views (docs/results.md, "A missing reading as evidence"), so it is not the default yet.
+
 Transition matrix (rows: state at t-1, columns: state at t, order O, M, E), the paper's
 Fig. 4 with its extra M -> O transition ``psi``::
 
@@ -128,6 +145,7 @@ ALPHA, BETA, GAMMA, PSI = GridConfig.alpha, GridConfig.beta, GridConfig.gamma, G
 P_OCC, P_FREE = GridConfig.p_occ, GridConfig.p_free
 TAIL_WIDTH = GridConfig.tail_width
 INITIAL = GridConfig.initial
+NO_RETURN = GridConfig.no_return
 #: Noise model for cameras whose intrinsics match no sensor preset (the noisier of the two).
 DEFAULT_NOISE_MODEL = "structured_light"
 #: Far range (metres) for cameras whose intrinsics match no sensor preset.
@@ -445,7 +463,10 @@ class OccupancyGrid:
     p_occ, p_free : the observation function's levels; tail_width : width of its tails in
         sensor depth standard deviations (module docstring)
     initial : (3,) initial distribution over (O, M, E), summing to 1 (module docstring)
-    max_range : as in :func:`spec_from_cameras`, used to check each camera sees part of the grid
+    max_range : as in :func:`spec_from_cameras`: each camera's far range (metres), where a
+        pixel that measured nothing is evidence against O in the cells in front of it, and
+        used to check each camera sees part of the grid
+    no_return : factor (0, 1] on O's likelihood in front of such a pixel (module docstring)
 
     After :meth:`update`: ``states`` (nx, ny, nz) uint8 MAP state (O, M, E),
     ``probabilities`` (nx, ny, nz, 3) float32 posterior over (O, M, E), ``visibility``
@@ -456,7 +477,7 @@ class OccupancyGrid:
     def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str | NoiseEstimate] | None = None, *,
                  alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
                  p_occ: float = P_OCC, p_free: float = P_FREE, tail_width: float = TAIL_WIDTH,
-                 initial=INITIAL, max_range=None):
+                 initial=INITIAL, max_range=None, no_return: float = NO_RETURN):
         if not isinstance(spec, GridSpec):
             raise ValueError(f"spec must be a GridSpec, got {type(spec).__name__}")
         self.spec = spec
@@ -470,6 +491,9 @@ class OccupancyGrid:
         if not (math.isfinite(tail_width) and tail_width >= 0):
             raise ValueError(f"tail_width must be a number >= 0, got {tail_width!r}")
         self.p_occ, self.p_free, self.tail_width = float(p_occ), float(p_free), float(tail_width)
+        if not (0.0 < no_return <= 1.0):
+            raise ValueError(f"no_return must be in (0, 1], got {no_return!r}")
+        self.no_return = float(no_return)
         initial = np.asarray(initial, np.float64)
         if initial.shape != (3,) or np.any(initial < 0) or abs(initial.sum() - 1.0) > 1e-6:
             raise ValueError(f"initial must be 3 probabilities for (O, M, E) summing to 1, got {initial.tolist()}")
@@ -487,7 +511,10 @@ class OccupancyGrid:
             if not isinstance(model, NoiseEstimate):
                 depth_std_coefficients(model)  # raises with the valid names
             self.noise_models[cam.name] = model
-        _check_coverage(spec, self.cameras, _max_ranges(self.cameras, max_range))
+        #: camera name -> its far range, metres along its optical axis
+        self.max_ranges = _max_ranges(self.cameras, max_range)
+        _check_coverage(spec, self.cameras, self.max_ranges)
+        self._fars = np.array([self.max_ranges[cam.name] for cam in self.cameras], np.float64)
         self._camera_arrays()
         self._probabilities = np.empty(spec.shape + (3,), np.float32)
         self._probabilities[...] = initial
@@ -608,7 +635,8 @@ class OccupancyGrid:
             hold = np.ascontiguousarray(hold).reshape(-1)
         self.stepped = _kernels.update_grid(
             self.spec.shape[0], self._pixels, self._depths_l, self._widths, self._offsets, self._depth,
-            self._half_extents, self.p_occ, self.p_free, self.transition, self.held_transition, hold, FLUSH,
+            self._half_extents, self._fars, self.p_occ, self.p_free, self.no_return, self.transition,
+            self.held_transition, hold, FLUSH,
             self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1), self._quiet,
         )
         self.num_updates += 1
