@@ -189,6 +189,9 @@ class GridConfig(_Section):
     no_return: float = setting(1.0, "factor on a static object's likelihood in a cell in front of a pixel that "
                                     "measured nothing, nearer than the camera's far range (1: no evidence, "
                                     "the paper's model)", "likelihood ratio", above=0, high=1)
+    no_return_after: int = setting(1, "frames in a row a pixel must have measured nothing before it counts as no "
+                                      "return for no_return (a background beyond range returns nothing in every "
+                                      "frame; a dropout on a surface lasts a frame or a few)", "frames", low=1)
     hold_people: bool = setting(True, "hold the cells of the people estimated in the last frame as moving, so a "
                                       "person standing still is not absorbed into the background")
     hold_margin: float = setting(0.1, "margin around each body capsule of the held cells", "m", low=0)

@@ -113,7 +113,7 @@ class Tracker:
         self.grid = OccupancyGrid(self.spec, cameras, {name: c.model for name, c in self.noise.items()},
                                   alpha=grid.alpha, beta=grid.beta, gamma=grid.gamma, psi=grid.psi, p_occ=grid.p_occ,
                                   p_free=grid.p_free, tail_width=grid.tail_width, initial=grid.initial, max_range=far,
-                                  no_return=grid.no_return)
+                                  no_return=grid.no_return, no_return_after=grid.no_return_after)
         blobs = config.blobs
         self.blobs = BlobTracker(self.fps, blobs.max_gap_s, gate_m=blobs.gate_m, gate_growth=blobs.gate_growth,
                                  claim_share=blobs.claim_share, merge_margin_m=blobs.merge_margin_m,

@@ -31,12 +31,14 @@ FRONT = camera_preset("kinect_v1", world_from_camera=look_at((0.0, 0.0, 1.6), (0
 # ------------------------------------------------------------------ NumPy references
 
 
-def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarray, hold=None):
+def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarray, hold=None, returnless=None):
     """One frame of the grid in plain NumPy: (probabilities (N, 3) float64, states (N,), visibility (N,)).
     hold : optional (N,) bool, cells stepped with psi = 0 (the M row renormalised), their O
         share moved to M first where their MAP state is M. Cells no camera sees whose MAP
         state is O step with alpha = 0. O's likelihood takes grid.no_return per camera whose
-        pixel measured nothing nearer than its far range, unless the cell's MAP state is O."""
+        pixel is returnless nearer than its far range, unless the cell's MAP state is O.
+    returnless : optional dict camera name -> (H, W) bool; default: every pixel that measured
+        nothing in this frame (grid.no_return_after = 1)."""
     centres = grid.spec.centers().reshape(-1, 3)
     likelihood = np.ones((len(centres), 3))
     covered = np.zeros(len(centres), bool)
@@ -56,7 +58,10 @@ def reference_update(grid: OccupancyGrid, depths: dict, probabilities: np.ndarra
         epsilon = np.where(valid, d - depth_l, np.nan)
         f = observation_function(epsilon, grid.half_extent(cam.name), width, grid.p_occ, grid.p_free)
         likelihood *= np.column_stack([f, f, 1.0 - f])
-        no_return[inside & ~valid & (depth_l <= grid.max_ranges[cam.name])] *= grid.no_return
+        absent = inside & ~valid
+        if returnless is not None:
+            absent[inside] &= returnless[cam.name][v[inside].astype(int), u[inside].astype(int)]
+        no_return[absent & (depth_l <= grid.max_ranges[cam.name])] *= grid.no_return
         covered |= valid
         with np.errstate(invalid="ignore"):
             seen |= valid & (epsilon >= -band)
@@ -237,6 +242,47 @@ def test_update_kernel_with_no_return_matches_numpy(rng):
     np.testing.assert_allclose(grid.probabilities.reshape(-1, 3), expected, atol=1e-6, rtol=0)
     with pytest.raises(ValueError, match="no_return must be in"):
         OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, no_return=0.0)
+
+
+def test_only_pixels_missing_for_no_return_after_frames_count_as_no_return(rng):
+    """With no_return_after = 4 a pixel counts as no return from its 4th frame in a row
+    without a reading: a third of the pixels drop out in a random third of the frames
+    (transient), a tenth measure nothing from frame 2 on (persistent). The beliefs follow
+    the reference given the pixels whose run of missing frames has reached 4, counted here
+    frame by frame; the transient holes alone never reach it."""
+    grid, depths = random_setup(rng)
+    grid = OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, p_free=0.08, no_return=0.5, max_range=4.0,
+                         no_return_after=4)
+    flickering = {name: rng.random(d.shape) < 1 / 3 for name, d in depths.items()}
+    persistent = {name: rng.random(d.shape) < 0.1 for name, d in depths.items()}
+    runs = {name: np.zeros(d.shape, int) for name, d in depths.items()}
+    expected = grid.probabilities.reshape(-1, 3).astype(np.float64)
+    counted = []
+    for t in range(12):
+        frame = {}
+        for name, d in depths.items():
+            d = d.copy()
+            d[flickering[name] & (rng.random(d.shape) < 1 / 3)] = 0.0
+            if t >= 2:
+                d[persistent[name]] = 0.0
+            frame[name] = d
+            runs[name] = np.where((d > 0) & np.isfinite(d), 0, runs[name] + 1)
+        returnless = {name: run >= 4 for name, run in runs.items()}
+        counted.append(sum(int(r.sum()) for r in returnless.values()))
+        expected = reference_update(grid, frame, expected.astype(np.float32), returnless=returnless)[0]
+        grid.update(frame)
+        assert_same_beliefs(grid, expected)
+    # the setup's holes (missing in every frame) count from frame 3, the persistent ones from
+    # frame 5; a flickering pixel rarely misses 4 frames in a row (1 in 81)
+    holes = {name: ~((d > 0) & np.isfinite(d)) for name, d in depths.items()}
+    always = sum(int(h.sum()) for h in holes.values())
+    both = sum(int((holes[name] | persistent[name]).sum()) for name in depths)
+    flickers = sum(int(f.sum()) for f in flickering.values())
+    assert counted[:3] == [0, 0, 0]
+    assert always <= counted[3] < always + 0.05 * flickers  # measured: 680 + 46 of 2084
+    assert both <= counted[5] < both + 0.05 * flickers and counted[5] > 1.5 * always  # measured: 1259 + 16
+    with pytest.raises(ValueError, match="no_return_after must be"):
+        OccupancyGrid(grid.spec, grid.cameras, grid.noise_models, no_return_after=0)
 
 
 def test_update_kernel_matches_numpy_over_frames(rng):

@@ -123,8 +123,8 @@ def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrins
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
-def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, fars, p_occ, p_free, no_return,
-                transition, held, hold, flush, probabilities, states, visibility, quiet):
+def update_grid(nx, pixels, depths_l, widths, offsets, depth, returnless, half_extents, fars, p_occ, p_free,
+                no_return, transition, held, hold, flush, probabilities, states, visibility, quiet):
     """One frame of the grid, in place; returns the number of cells whose HMM step ran.
 
     nx : int, the grid's x slices (run in parallel; the N cells are nx slices of N / nx)
@@ -132,10 +132,12 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, fars
         cell centre's pixel in each camera's image (-1: none), depth along its optical axis
         and tail width, from :func:`pixels_from_cells`
     offsets (C,) int64; depth (sum H*W,) float32 metres (<= 0 or not finite: no measurement)
+    returnless (sum H*W,) bool: pixels that have measured nothing for long enough to count as
+        no return (:meth:`occupose.grid.occupancy.OccupancyGrid.update`)
     half_extents (C,) float64 metres; fars (C,) float64 metres, each camera's far range
     p_occ, p_free : floats of the observation function
-    no_return : float in (0, 1], the factor on O's likelihood per camera whose pixel measured
-        nothing while the cell is nearer than its far range (a static surface there would
+    no_return : float in (0, 1], the factor on O's likelihood per camera whose pixel is
+        returnless while the cell is nearer than its far range (a static surface there would
         have returned; M and E are alike, so a person's dropouts cut no holes): class
         NO_RETURN. A cell whose MAP state is O before the step takes no factor: as for a
         static cell no camera sees, a missing reading does not remove it
@@ -186,7 +188,7 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, half_extents, fars
                     continue
                 d = depth[offsets[c] + pixel]
                 if not (d > 0.0 and d < np.inf):
-                    if no_return < 1.0 and depths_l[n, c] <= fars[c]:
+                    if no_return < 1.0 and returnless[offsets[c] + pixel] and depths_l[n, c] <= fars[c]:
                         b_static *= no_return
                         if code > 0:
                             code += NO_RETURN * power_c

@@ -39,7 +39,11 @@ not cover a cell adds nothing.
 An option, off by default (``no_return = 1``, the paper's model): a pixel that measures
 nothing (d = 0) while the cell centre is nearer than the camera's far range (``max_range``)
 is evidence against a static surface in the cell, which would have returned a reading:
-its likelihoods are ``B = (no_return, 1, 1)``.
+its likelihoods are ``B = (no_return, 1, 1)``. Such a pixel counts only once it has
+measured nothing for ``no_return_after`` frames in a row (``returnless``): a background
+beyond range returns nothing in every frame, whereas the dropouts of a surface (dark
+cloth, glancing angles, the sensor's worst-case noise) come and go, and in their frames
+would take O's share from the surface's cells before these settle as static.
 M keeps 1, as E: a moving person's dropouts (dark hair, a glancing surface) last a frame
 or two and cut no holes. Without it, space in front of a background beyond the sensor's
 range is never observed and keeps the initial distribution's O share, and a person who
@@ -146,6 +150,7 @@ P_OCC, P_FREE = GridConfig.p_occ, GridConfig.p_free
 TAIL_WIDTH = GridConfig.tail_width
 INITIAL = GridConfig.initial
 NO_RETURN = GridConfig.no_return
+NO_RETURN_AFTER = GridConfig.no_return_after
 #: Noise model for cameras whose intrinsics match no sensor preset (the noisier of the two).
 DEFAULT_NOISE_MODEL = "structured_light"
 #: Far range (metres) for cameras whose intrinsics match no sensor preset.
@@ -467,6 +472,8 @@ class OccupancyGrid:
         pixel that measured nothing is evidence against O in the cells in front of it, and
         used to check each camera sees part of the grid
     no_return : factor (0, 1] on O's likelihood in front of such a pixel (module docstring)
+    no_return_after : frames in a row (>= 1) a pixel must have measured nothing before it
+        counts as no return (module docstring)
 
     After :meth:`update`: ``states`` (nx, ny, nz) uint8 MAP state (O, M, E),
     ``probabilities`` (nx, ny, nz, 3) float32 posterior over (O, M, E), ``visibility``
@@ -477,7 +484,8 @@ class OccupancyGrid:
     def __init__(self, spec: GridSpec, cameras, noise_models: Mapping[str, str | NoiseEstimate] | None = None, *,
                  alpha: float = ALPHA, beta: float = BETA, gamma: float = GAMMA, psi: float = PSI,
                  p_occ: float = P_OCC, p_free: float = P_FREE, tail_width: float = TAIL_WIDTH,
-                 initial=INITIAL, max_range=None, no_return: float = NO_RETURN):
+                 initial=INITIAL, max_range=None, no_return: float = NO_RETURN,
+                 no_return_after: int = NO_RETURN_AFTER):
         if not isinstance(spec, GridSpec):
             raise ValueError(f"spec must be a GridSpec, got {type(spec).__name__}")
         self.spec = spec
@@ -494,6 +502,10 @@ class OccupancyGrid:
         if not (0.0 < no_return <= 1.0):
             raise ValueError(f"no_return must be in (0, 1], got {no_return!r}")
         self.no_return = float(no_return)
+        if isinstance(no_return_after, bool) or not isinstance(no_return_after, (int, np.integer)) \
+                or not 1 <= no_return_after < np.iinfo(np.uint16).max:
+            raise ValueError(f"no_return_after must be a whole number of frames in [1, 65534], got {no_return_after!r}")
+        self.no_return_after = int(no_return_after)
         initial = np.asarray(initial, np.float64)
         if initial.shape != (3,) or np.any(initial < 0) or abs(initial.sum() - 1.0) > 1e-6:
             raise ValueError(f"initial must be 3 probabilities for (O, M, E) summing to 1, got {initial.tolist()}")
@@ -551,6 +563,10 @@ class OccupancyGrid:
             measured = isinstance(model, NoiseEstimate)
             self._sigma_lut[c] = model.std(lut_depths) if measured else depth_std(lut_depths, model)
         self._depth = np.empty(offset, np.float32)
+        #: (sum H*W,) frames in a row each pixel has measured nothing, at most no_return_after,
+        #: and the pixels where it has reached no_return_after (returnless, :meth:`update`)
+        self._missing_run = np.zeros(offset, np.uint16)
+        self._returnless = np.zeros(offset, np.bool_)
         num_cells = self.spec.num_cells
         #: (N, C) each cell centre's flat pixel index in each image (-1: none), its depth along
         #: the optical axis (metres) and the observation function's tail width there (metres).
@@ -633,9 +649,15 @@ class OccupancyGrid:
                 raise ValueError(f"hold must be a bool array of the grid's shape {self.spec.shape}, "
                                  f"got {hold.dtype} {hold.shape}")
             hold = np.ascontiguousarray(hold).reshape(-1)
+        if self.no_return < 1.0:
+            run = self._missing_run
+            run += 1
+            run[(self._depth > 0.0) & (self._depth < np.inf)] = 0
+            np.minimum(run, self.no_return_after, out=run)
+            np.greater_equal(run, self.no_return_after, out=self._returnless)
         self.stepped = _kernels.update_grid(
             self.spec.shape[0], self._pixels, self._depths_l, self._widths, self._offsets, self._depth,
-            self._half_extents, self._fars, self.p_occ, self.p_free, self.no_return, self.transition,
+            self._returnless, self._half_extents, self._fars, self.p_occ, self.p_free, self.no_return, self.transition,
             self.held_transition, hold, FLUSH,
             self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1), self._quiet,
         )
