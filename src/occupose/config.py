@@ -186,10 +186,10 @@ class GridConfig(_Section):
     tail_width: float = setting(2.0, "width of the observation function's tails", "sensor depth std", low=0)
     initial: tuple[float, float, float] = setting((0.4, 0.0, 0.6), "initial distribution over (O, M, E)",
                                                   "probability", low=0, high=1)
-    no_return: float = setting(1.0, "factor on a static object's likelihood in a cell in front of a pixel that "
+    no_return: float = setting(0.5, "factor on a static object's likelihood in a cell in front of a pixel that "
                                     "measured nothing, nearer than the camera's far range (1: no evidence, "
                                     "the paper's model)", "likelihood ratio", above=0, high=1)
-    no_return_after: int = setting(1, "frames in a row a pixel must have measured nothing before it counts as no "
+    no_return_after: int = setting(15, "frames in a row a pixel must have measured nothing before it counts as no "
                                       "return for no_return (a background beyond range returns nothing in every "
                                       "frame; a dropout on a surface lasts a frame or a few)", "frames", low=1)
     hold_people: bool = setting(True, "hold the cells of the people estimated in the last frame as moving, so a "
