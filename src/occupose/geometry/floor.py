@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from occupose.camera import Camera, points_from_depth
+from occupose.geometry import _floor_kernels
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,18 @@ def _plane(points: np.ndarray) -> tuple[np.ndarray, float]:
     return (normal, offset) if offset >= 0 else (-normal, -offset)
 
 
+def plane_inliers(points: np.ndarray, tolerance: np.ndarray, normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """(H,) int64: how many of the points (N, 3) metres lie within their ``tolerance`` (N,)
+    metres of each plane ``normals[h] . p + offsets[h] = 0`` (normals (H, 3) unit vectors,
+    offsets (H,) metres)."""
+    x, y, z = (np.ascontiguousarray(points[:, i], dtype=np.float64) for i in range(3))
+    counts = np.empty(len(normals), np.int64)
+    _floor_kernels.plane_inliers(x, y, z, np.ascontiguousarray(tolerance, dtype=np.float64),
+                                 np.ascontiguousarray(normals, dtype=np.float64),
+                                 np.ascontiguousarray(offsets, dtype=np.float64), counts)
+    return counts
+
+
 def fit_floor(points: np.ndarray, config, *, gravity: np.ndarray | None = None, seed: int = 0) -> Floor | None:
     """The floor among (N, 3) camera-frame points (metres), or None when no plane can be it.
 
@@ -106,7 +119,7 @@ def fit_floor(points: np.ndarray, config, *, gravity: np.ndarray | None = None, 
         if not len(normals):
             break
         offsets = -np.einsum("ij,ij->i", normals, a)
-        counts = (np.abs(points[pool] @ normals.T + offsets) < tolerance[pool, None]).sum(axis=0)
+        counts = plane_inliers(points[pool], tolerance[pool], normals, offsets)
         best = int(np.argmax(counts))
         if counts[best] < config.min_share * len(points):
             break

@@ -84,6 +84,7 @@ class PoseProblem:
         self.heading_dof = model.dof_names.index("heading") if "heading" in model.dof_names else None
         self._heading_part = next((int(g.parts[0]) for g in model.weight_groups if self.heading_dof in g.dofs), None)
         self._likelihood = None
+        self._observed = None  # the observation self._likelihood was built on
 
     def resize(self, model: BodyModel) -> None:
         """Go on with ``model``: the same model with other body dimensions (its DOFs,
@@ -96,8 +97,12 @@ class PoseProblem:
         self.model = model
 
     def set_observation(self, observation: Observation) -> None:
-        """Use this frame's observation for the following likelihood calls."""
-        self._likelihood = make_likelihood(self.likelihood_name, observation, **self.likelihood_options)
+        """Use this frame's observation for the following likelihood calls. The likelihood
+        is built once per observation (an Observation is immutable): the filter steps on one
+        frame set the same one again, and building the free-space term reads its whole images."""
+        if observation is not self._observed:
+            self._likelihood = make_likelihood(self.likelihood_name, observation, **self.likelihood_options)
+            self._observed = observation
 
     def log_likelihood(self, poses: np.ndarray) -> np.ndarray:
         """(P, K) per-part log-likelihoods of poses (P, D); hidden parts give 0."""

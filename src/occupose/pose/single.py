@@ -209,13 +209,12 @@ def people_of_points(points: np.ndarray, groups: np.ndarray, config: TrackerConf
     out = np.full(len(points), -1, np.int64)
     for k, g in enumerate(people):
         out[groups == g] = k
-    if not people:
+    parts = [g for g in np.flatnonzero(counts >= fit.min_part) if g not in people]
+    if not people or not parts:
         return out
-    trees = [cKDTree(points[out == k]) for k in range(len(people))]
-    for g in np.flatnonzero(counts >= fit.min_part):
+    trees = [cKDTree(points[out == k]) for k in range(len(people))]  # 10-20 ms each for a close person
+    for g in parts:
         own = groups == g
-        if out[own][0] >= 0:
-            continue
         gaps = [float(tree.query(points[own], distance_upper_bound=fit.reach_m)[0].min()) for tree in trees]
         if min(gaps) <= fit.reach_m:
             out[own] = int(np.argmin(gaps))
