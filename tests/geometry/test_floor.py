@@ -7,7 +7,7 @@ import pytest
 
 from occupose.camera import Camera, points_from_depth
 from occupose.config import FloorConfig
-from occupose.geometry.floor import Floor, fit_floor
+from occupose.geometry.floor import Floor, fit_floor, plane_inliers
 from occupose.io.recording import Recording, RecordingWriter
 from occupose.io.sources import HeightTilt, NoWorldPoseError, open_source, place_from_floor, placement, without_pose
 from occupose.synth.catalogue import render_scenario
@@ -79,3 +79,19 @@ def test_no_floor_in_view_says_how_to_give_the_pose(tmp_path):
             writer.write_frame({"cam0": np.zeros((24, 32), np.uint16)})
     with pytest.raises(NoWorldPoseError, match="no floor was found .* --camera-height H --tilt DEGREES"):
         open_source(tmp_path / "rec", find_floor=True)
+
+
+def test_plane_inliers_counts_as_the_distance_matrix_does():
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-2.0, 2.0, (5000, 3))
+    points[:2000, 2] = 0.01 * rng.standard_normal(2000)  # a plane for some hypotheses to find
+    tolerance = 0.02 + 0.01 * np.abs(points[:, 2])
+    normals = rng.standard_normal((64, 3))
+    normals[:8] = [0.0, 0.0, 1.0]
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    offsets = rng.uniform(-0.5, 0.5, 64)
+    offsets[:8] = 0.0
+    expected = (np.abs(points @ normals.T + offsets) < tolerance[:, None]).sum(axis=0)
+    counts = plane_inliers(points, tolerance, normals, offsets)
+    assert counts.dtype == np.int64 and counts[:8].min() >= 1900  # 2 sigma: about 2 % of them are off the plane
+    np.testing.assert_array_equal(counts, expected)

@@ -130,6 +130,21 @@ def test_log_likelihood_per_part_true_pose_beats_perturbed_and_hidden_parts_give
                           np.delete(values, model.part_names.index("left_shin"), axis=1))
 
 
+def test_setting_the_same_observation_again_keeps_its_likelihood_and_a_new_one_replaces_it(walk):
+    gt, observations = walk
+    model = body_model("full", dims=dims_from_joints(gt))
+    problem, fresh = PoseProblem(model), PoseProblem(model)
+    poses = pose_from_joints(model, gt[10])[None] + np.random.default_rng(4).normal(0.0, 0.05, (8, model.num_dofs))
+    problem.set_observation(observations[10])
+    built = problem._likelihood
+    problem.set_observation(observations[10])
+    assert problem._likelihood is built
+    problem.set_observation(observations[11])
+    fresh.set_observation(observations[11])
+    assert problem._likelihood is not built
+    assert np.array_equal(problem.log_likelihood(poses), fresh.log_likelihood(poses))
+
+
 def test_walking_costs_facing_away_from_the_way_walked_on_the_heading_part(walk):
     gt, observations = walk
     model = body_model("full", dims=dims_from_joints(gt))
