@@ -240,7 +240,7 @@ def test_presets_carry_the_documented_sensor_values():
     assert CAMERA_PRESETS["realsense_d435"] == SensorSpec(
         "realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "structured_light")
     azure = sensor_spec("azure_nfov")
-    assert (azure.width, azure.height, azure.cx, azure.cy, azure.noise) == (640, 576, 332.78, 304.83, "tof")
+    assert (azure.width, azure.height, azure.cx, azure.cy, azure.noise) == (640, 576, 332.78, 348.83, "tof")
     assert (azure.near, azure.far) == (0.5, 3.86)
     # 75 x 65 degree field of view
     # factory calibration: normalised fx 0.49278 of the 1024-px sensor; pinhole FOV ~65 x 59 deg

@@ -378,7 +378,9 @@ class SensorSpec:
 
 #: Depth sensors by name. Intrinsics from ../shared/data/README.md; Azure Kinect NFOV
 #: unbinned from the real factory calibration in ../shared/data/sensors/azure_kinect
-#: (normalised cx, cy, fx, fy of the 1024 x 1024 depth sensor, cropped to 640 x 576; the
+#: (normalised cx, cy, fx, fy of the 1024 x 1024 depth sensor, taken to 640 x 576 as the
+#: Azure Kinect SDK does: the crop starts 192 px from the left and 180 px from the top, not
+#: centred, so cy is 348.83 and not 304.83, the value this preset had until 2026-12-07; the
 #: nominal 75 x 65 degree field of view includes lens distortion a pinhole cannot carry).
 #: Ranges from the makers' specs (Kinect v1: the raw stream's practical 0.5-4.5 m, wider
 #: than the 0.8-4.0 m its Windows SDK reports by default).
@@ -387,7 +389,7 @@ CAMERA_PRESETS: dict[str, SensorSpec] = {
     for spec in (
         SensorSpec("kinect_v1", 640, 480, 594.21, 591.04, 339.5, 242.7, 0.5, 4.5, "structured_light"),
         SensorSpec("kinect_v2", 512, 424, 365.5, 365.5, 254.9, 205.4, 0.5, 4.5, "tof"),
-        SensorSpec("azure_nfov", 640, 576, 504.61, 504.73, 332.78, 304.83, 0.5, 3.86, "tof"),
+        SensorSpec("azure_nfov", 640, 576, 504.61, 504.73, 332.78, 348.83, 0.5, 3.86, "tof"),
         SensorSpec("realsense_d435", 640, 480, 382.6, 382.6, 319.0, 246.3, 0.3, 3.0, "structured_light"),
     )
 }

@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("av")
 
-from occupose.camera import Camera, raw_depth_from_metres  # noqa: E402
+from occupose.camera import Camera, matching_preset, raw_depth_from_metres  # noqa: E402
 from occupose.io.mkv import (DEPTH_MODES, MkvSource, camera_from_calibration,  # noqa: E402
                              gravity_from_accelerations, imu_samples)
 from occupose.io.recording import RecordingWriter  # noqa: E402
@@ -50,6 +50,15 @@ def test_calibration_to_mode_specific_intrinsics_by_hand(mode, expected):
     camera = camera_from_calibration(calibration_of(SHARED_NORMALISED), mode)
     got = (camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy)
     assert got == pytest.approx(expected, abs=1e-5) and camera.depth_scale == 0.001 and camera.name == "cam0"
+
+
+def test_a_real_nfov_calibration_is_the_azure_preset():
+    """The shared device's factory calibration, taken to NFOV unbinned, is the azure_nfov preset
+    (its ToF noise model and 3.86 m far range): the preset's cy once came from a centred crop
+    (304.83, 12.6 % off) and no real Azure Kinect matched it."""
+    camera = camera_from_calibration(calibration_of(SHARED_NORMALISED), "NFOV_UNBINNED")
+    assert matching_preset(camera) == "azure_nfov"
+    assert matching_preset(camera_from_calibration(calibration_of(SHARED_NORMALISED), "NFOV_2X2BINNED")) is None
 
 
 def test_bad_calibrations_and_modes_are_value_errors():
