@@ -129,3 +129,40 @@ def test_export_in_the_camera_frame_of_a_recording_without_a_pose_needs_the_runs
                     "--out", tmp_path / "x.json")
     assert result.exit_code == 1 and "its camera frame is unknown; export in the world frame" in result.output
     assert not (tmp_path / "x.json").exists()
+
+
+def test_a_bag_of_several_depth_topics_is_exported_with_the_topic_the_run_was_given(rec, tmp_path):
+    """summary.json records how the recording was read (reader and options, here the topic
+    chosen with --topic), and export opens the bag with them: without them it cannot choose
+    between the bag's two depth topics."""
+    pytest.importorskip("rosbags")
+    from occupose.testing import bag_typestore, camera_info_message, image_message, write_bag
+
+    IMAGE, INFO = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo"
+
+    recording = Recording(rec)
+    camera = recording.cameras[0]
+    store = bag_typestore(1)
+    messages = [(f"/{n}/depth/camera_info", INFO, 1, camera_info_message(store, camera, frame_id=n)) for n in "ab"]
+    for f in recording.frames():
+        raw = raw_depth_from_metres(f.depth[camera.name], camera)
+        for n, image in (("a", raw), ("b", np.zeros_like(raw))):
+            messages.append((f"/{n}/depth/image_raw", IMAGE, 10 + f.index,
+                             image_message(store, image, "16UC1", 5.0 + f.index / recording.fps, frame_id=n)))
+    bag = write_bag(tmp_path / "two.bag", messages, store)
+    height, tilt = camera.position[2], np.degrees(camera.down_angle)
+    run = tmp_path / "run"
+    result = invoke("track", bag, "--topic", "/a/depth/image_raw", "--camera-height", height, "--tilt", tilt,
+                    "--format", "json", "--out", run, *FAST)
+    assert result.exit_code == 0, result.output
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["source"] == {"reader": "bag", "options": {"topic": "/a/depth/image_raw"}}
+    exported = tmp_path / "exported.json"
+    result = invoke("export", run / "tracks.csv", "--to", "json", "--out", exported)
+    assert result.exit_code == 0, result.output
+    ran, again = (json.loads(path.read_text())["frames"] for path in (run / "tracks.json", exported))
+    assert ran == again and sum(len(f["bodies"]) for f in ran) >= FRAMES // 2  # the person tracked
+    del summary["source"]  # a summary without it: the bag's topics are ambiguous
+    (run / "summary.json").write_text(json.dumps(summary))
+    result = invoke("export", run / "tracks.csv", "--to", "json", "--out", tmp_path / "x.json")
+    assert result.exit_code == 1 and "several depth image topics" in result.output

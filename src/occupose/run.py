@@ -45,6 +45,8 @@ class TrackingResult:
     noise : camera name -> what the grid assumed of it (:meth:`occupose.grid.noise.CameraNoise.to_dict`)
     cameras : each camera's height, tilt, roll and where its pose came from
         (:func:`occupose.io.sources.placement`)
+    source : how the recording was read: its reader and the options that open it again
+        (:func:`occupose.io.sources.source_of`)
     """
 
     tracks: dict[int, tuple[np.ndarray, np.ndarray]]
@@ -57,6 +59,7 @@ class TrackingResult:
     overlap: bool = False
     noise: dict[str, dict] = field(default_factory=dict)
     cameras: list[dict] = field(default_factory=list)
+    source: dict = field(default_factory=dict)
 
 
 def track_frames(tracker: Tracker, frames: Iterable, num_frames: int, progress: Callable[[int], None] | None = None,
@@ -145,7 +148,7 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     when the recording was opened).
     """
     from occupose.io.prefetch import Prefetch
-    from occupose.io.sources import placement
+    from occupose.io.sources import placement, source_of
 
     recording = _as_recording(recording)
     config = as_config(config)
@@ -161,6 +164,7 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     with Prefetch(recording.frames(color=False)) as frames:  # the next frames decoded while this one is tracked
         result = track_frames(tracker, frames, recording.num_frames, progress, overlap=overlap)
     result.cameras = placement(recording)
+    result.source = source_of(recording)
     if warm_seconds is not None:
         result.seconds["warm_up"] = warm_seconds
     return result
@@ -184,8 +188,9 @@ def summary_of(result: TrackingResult, recording_path: str | os.PathLike, method
     one: the base of its config), seed, body model, the whole resolved config, whether the
     grid ran ahead on a thread, each camera's noise model and far range and its pose (height,
     tilt, roll, and whether the recording had it, it was given or found from the floor),
-    frames, people, seconds per stage and frames/s (start-up excluded)."""
-    return {"recording": str(recording_path), "method": method, "seed": result.seed, "model": result.model,
+    how the recording was read (its reader and the reader options that open it again, such
+    as a bag's topic), frames, people, seconds per stage and frames/s (start-up excluded)."""
+    return {"recording": str(recording_path), "source": result.source, "method": method, "seed": result.seed, "model": result.model,
             "config": result.config.to_dict(), "overlap": result.overlap, "noise": result.noise,
             "cameras": result.cameras,
             "frames": result.num_frames, "people": len(result.tracks),

@@ -70,6 +70,19 @@ def summary_of_run(tracks_csv: Path) -> dict:
     return data
 
 
+def reading_of_run(summary: dict) -> dict:
+    """How a run's ``summary`` (as :func:`summary_of_run`) says its recording was read:
+    ``{"reader": name or None, "options": {...}}`` (``{}`` for a summary from before it was
+    recorded). ValueError for one that is not plain data of that shape."""
+    read = summary.get("source")
+    if read is None:
+        return {}
+    if (not isinstance(read, dict) or not isinstance(read.get("options", {}), dict)
+            or not isinstance(read.get("reader"), (str, type(None)))):
+        raise ValueError(f"summary.json: its source must be {{\"reader\": name, \"options\": {{...}}}}, got {read!r}")
+    return {"reader": read.get("reader"), "options": read.get("options", {})}
+
+
 def poses_of_run(summary: dict) -> dict[str, np.ndarray]:
     """Camera name -> (4, 4) world_from_camera of the cameras a run's ``summary`` (as
     :func:`summary_of_run`) lists as placed by the run (a pose given or found from the
@@ -93,7 +106,9 @@ def export_tracks(tracks_csv: str | os.PathLike, to: str, out: str | os.PathLike
     a file occupose wrote). ``recording`` : the recording the tracks are of (any format,
     read by its reader), by default the one the run's summary.json names. The camera frame
     is the one the run placed the camera in: the pose summary.json lists where the run gave
-    or found it (:func:`poses_of_run`), else the recording's own. Returns ``out``."""
+    or found it (:func:`poses_of_run`), else the recording's own. The recording is opened
+    with the reader and reader options summary.json records (a bag's topic), if any.
+    Returns ``out``."""
     from occupose.io.joint_table import read_tracks_csv
     from occupose.io.sources import reader_for
 
@@ -104,7 +119,8 @@ def export_tracks(tracks_csv: str | os.PathLike, to: str, out: str | os.PathLike
     has_summary = (tracks_csv.parent / "summary.json").is_file()
     summary = summary_of_run(tracks_csv) if recording is None or has_summary else {}
     path = Path(recording if recording is not None else summary["recording"])
-    source = reader_for(path).open(path)
+    read = reading_of_run(summary) if summary and path == Path(summary["recording"]) else {}
+    source = reader_for(path, read.get("reader")).open(path, **read.get("options", {}))
     name = check_frame(frame, camera, source.cameras)
     poses = poses_of_run(summary)
     if name is not None and name not in poses and not getattr(source, "pose_known", True):

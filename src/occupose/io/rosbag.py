@@ -207,6 +207,7 @@ class BagSource(StreamSource):
             counts[connection.topic] = counts.get(connection.topic, 0) + connection.msgcount
         images = [t for t, kind in topics.items() if kind == IMAGE and counts[t] > 0]
         self.topic = self._choose(reader, images, topic, topics)
+        self.reader_options = {"topic": self.topic}
         first = self._first(reader, self.topic, FPS_FRAMES)
         image = first[0][0]
         self.encoding = image.encoding

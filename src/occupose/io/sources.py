@@ -69,7 +69,9 @@ class StreamSource:
     when ``color`` is False), time the frame's device timestamp in seconds (any origin: the
     first frame's is subtracted) or None where the format has none (then index / fps).
     ``gravity`` : dict camera name -> (3,) camera-frame direction of gravity from
-    the file's IMU, where it has one (the floor estimate uses it).
+    the file's IMU, where it has one (the floor estimate uses it). ``reader_options`` :
+    the reader options that open the same recording again, as plain data, with what the
+    reader found for itself (a bag's topic when none was given), for ``summary.json``.
     """
 
     path: Path
@@ -78,6 +80,8 @@ class StreamSource:
     cameras: list[Camera]
     pose_known: bool = False
     gravity: Mapping[str, np.ndarray] = {}
+    reader: str | None = None
+    reader_options: Mapping[str, Any] = {}
     _color_names: tuple[str, ...] = ()
 
     def _raw_frames(self, color: bool) -> Iterator[tuple[dict[str, np.ndarray], dict[str, np.ndarray],
@@ -266,8 +270,12 @@ def open_source(path: str | os.PathLike, *, format: str | None = None, pose: Hei
     find_floor : place the cameras from the floor even when the recording has a pose
     floor : the :class:`occupose.config.FloorConfig` of the floor estimate (None: the default)
     options : the reader's own (``topic`` for bags, ``camera`` for TUM folders, ...)
+
+    The source's ``reader`` is the name of the reader that opened it (:func:`source_of`).
     """
-    source = reader_for(path, format).open(Path(path), **options)
+    reader = reader_for(path, format)
+    source = reader.open(Path(path), **options)
+    source.reader = reader.name
     if find_floor:
         if pose is not None:
             raise SourceError(f"{path}: give either a pose or find_floor, not both")
@@ -308,6 +316,13 @@ def place_from_floor(source: StreamSource, config=None) -> StreamSource:
     return source.placed({camera.name: floor.world_from_camera()}, "floor")
 
 
+def source_of(source: FrameSource) -> dict[str, Any]:
+    """How ``source`` was read, for ``summary.json``: ``reader`` (its :data:`READERS` name,
+    None when it was not opened by :func:`open_source`) and ``options`` (the reader options
+    that open it again, ``StreamSource.reader_options``)."""
+    return {"reader": getattr(source, "reader", None), "options": dict(getattr(source, "reader_options", {}))}
+
+
 def placement(source: FrameSource) -> list[dict[str, Any]]:
     """Each camera's pose as a user reads it: ``name``, ``height_m`` (above the floor z = 0),
     ``tilt_deg`` (the optical axis below the horizontal), ``roll_deg`` and ``pose`` (where
@@ -332,6 +347,8 @@ class _Unplaced(StreamSource):
         self.cameras = [replace(c, world_from_camera=np.eye(4)) for c in source.cameras]
         self._color_names = tuple(source.color_cameras)
         self.gravity = dict(getattr(source, "gravity", {}))
+        self.reader = getattr(source, "reader", None)
+        self.reader_options = dict(getattr(source, "reader_options", {}))
         self._source = source
 
     def _raw_frames(self, color):

@@ -163,6 +163,7 @@ class TumSource(StreamSource):
             raise SourceError(f"{self.path}: no {LIST}; a TUM RGB-D folder lists its depth images there")
         entries = read_list(listing)
         fx, fy, cx, cy = intrinsics_for(self.path, camera)
+        self.reader_options = {"camera": {"fx": fx, "fy": fy, "cx": cx, "cy": cy}}
         self.stamps = [stamp for stamp, _ in entries]
         self.files = [self.path / name for _, name in entries]
         first = _read_depth_png(self.files[0])
