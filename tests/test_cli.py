@@ -147,6 +147,7 @@ def test_track_command_writes_tracks_and_summary(tmp_path, walk):
     assert "1 track(s) in 25 frames" in result.output and "person 1 (track 1) all joints" in result.output
     summary = json.loads((out / "summary.json").read_text())
     assert summary["method"] == "ours" and summary["seed"] == 0
+    assert summary["source"] == {"reader": "folder", "options": {}}
     assert summary["model"] == "full"  # what auto chose for a front camera
     assert summary["frames"] == 25 and summary["people"] == 1 and summary["fps"] > 0
     # the whole resolved config: the file's, the flags' and --set's values, the method's defaults
