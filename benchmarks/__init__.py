@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import time
 
-from occupose.evaluation.report import markdown_table
+from occupose._numba import configure
+
+configure()  # before any benchmark imports numba: kernels cached, idle OpenMP threads asleep
+
+from occupose.evaluation.report import markdown_table  # noqa: E402
 
 
 def median_seconds(function, repeats: int, warmup: int = 3, clock=time.perf_counter) -> tuple[float, float]:

@@ -7,11 +7,7 @@ import platform
 import time
 from pathlib import Path
 
-from occupose._numba import configure
-
-configure()  # before any benchmark imports numba
-
-from benchmarks import (  # noqa: E402
+from benchmarks import (
     bench_bag,
     bench_blobs,
     bench_body,
