@@ -212,7 +212,7 @@ class Tracker:
                                                    pixels, depths, assigned)
         for pid, person in self.people.items():
             if pid not in out:  # gone (behind something): kept, not estimated
-                person.carry()
+                person.carry(depths)
                 out[pid] = person.estimate(False)
         _tick(seconds, "pose", clock)
         return FrameResult(dict(sorted(out.items())), looked_back, assigned, seconds)

@@ -76,7 +76,7 @@ def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     np.testing.assert_allclose(person.path[-1], [2.0, 1.0])  # the jump is no step: same way, same speed
     direction, weight = person.walking()
     assert direction == pytest.approx(0.0) and weight == pytest.approx(CARRY.walk_prior)
-    person.carry()  # hidden again at once: carried on along +x
+    person.carry({})  # hidden again at once: carried on along +x (no camera sees through it)
     np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])
 
 
@@ -96,7 +96,7 @@ def test_a_person_carried_out_of_sight_at_a_walk_stands_its_legs(speed):
     person.pose, person.centroid = stride.copy(), np.array([0.0, 0.0, 1.0])
     person.occlusion.memory = stride.copy()
     person.path = [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)]
-    person.carry()
+    person.carry({})
     legs = np.array([n.startswith(CARRY.stand_dofs) for n in model.dof_names])
     assert legs.sum() == 8 and person.walked_on == (speed > CARRY.walk_from)
     rest = standing_pose(model) if person.walked_on else stride
@@ -130,7 +130,7 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s, the blob stalls
         person.settle(pose + np.eye(model.num_dofs)[0] * (0.18 + 0.01 * (i + 1)), np.array([0.2, 0.0]))
     np.testing.assert_allclose(person.step(), [0.04, 0.0])
-    person.carry()
+    person.carry({})
     np.testing.assert_allclose(person.pose[:2], [0.27, 0.0])
     assert person.walked_on  # carried at 1.2 m/s: it comes back there, not on its blob
     person.come_back(np.array([0.9, 0.3, 1.0]))
@@ -140,7 +140,7 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     for _ in range(CARRY.frames):  # standing partly hidden for long: its own recent path again
         person.settle(person.pose, np.array([0.3, 0.0]))
     np.testing.assert_allclose(person.step(), [0.0, 0.0], atol=1e-12)
-    person.carry()
+    person.carry({})
     assert not person.walked_on  # carried standing: it comes back on its blob
     person.come_back(np.array([0.9, 0.3, 1.0]))
     np.testing.assert_allclose(person.pose[:2], np.array([0.9, 0.3]) + person.anchor)
@@ -204,3 +204,26 @@ def test_a_person_standing_still_is_turned_to_the_way_its_limbs_bend(standing_st
         assert runs[True][0] > 150 and np.all(runs[True][-15:] < 30)
     else:
         assert np.all(runs[True] < 30)
+
+
+def test_a_person_carried_into_space_a_camera_sees_through_stays():
+    """Carried at a walk, a person walks on behind something (the camera measures a surface
+    in front of where its torso goes), but not into space the camera sees through (a
+    surface measured beyond it): nobody is there, so the walk out of sight has stopped."""
+    from occupose.camera import camera_preset, look_at
+
+    camera = camera_preset("kinect_v1", world_from_camera=look_at((0.0, -3.0, 1.5), (0.0, 0.0, 1.0)),
+                           camera_name="front")
+    model = body_model("full")
+    for depth, walks in ((1.0, True), (6.0, False)):  # a cabinet 1 m from the camera; a wall 6 m away
+        person = Person(model, TrackerConfig(), 30.0, np.random.default_rng(0), (camera,))
+        pose = standing_pose(model, (0.0, 0.0), 0.0)
+        person.estimator.initialise(pose, 0.0)
+        person.pose, person.centroid = pose.copy(), np.array([0.0, 0.0, 1.0])
+        person.path = [np.array([0.04 * i, 0.0]) for i in range(CARRY.frames)]  # 1.2 m/s along +x
+        image = np.full((camera.height, camera.width), depth, np.float32)
+        assert person.carry({"front": image}) == walks and person.lost
+        np.testing.assert_allclose(person.pose[:2], [0.04, 0.0] if walks else [0.0, 0.0])
+        assert person.walked_on == walks
+        holes = np.zeros_like(image)  # no measurement sees through nothing: it walks on
+        assert person.carry({"front": holes})

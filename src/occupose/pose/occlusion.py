@@ -233,20 +233,55 @@ def hidden_parts_in_views(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsu
     owners : camera name -> (H, W) int track id of each pixel (0 = nobody)
     Returns (num_parts,) bool.
     """
-    t = (np.arange(n) + 0.5) / n
-    centres = (a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]).reshape(-1, 3)
-    radius = (radii[:, :1] + t[None, :] * (radii[:, 1:] - radii[:, :1])).reshape(-1)
+    centres, radius = _spheres(a, b, radii, n)
     hidden = np.ones(len(centres), bool)
     for camera in cameras:
-        uv, z = pixels_from_points(centres, camera)
-        uv = np.round(np.nan_to_num(uv, nan=-1.0, posinf=-1.0, neginf=-1.0))
-        u, v = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
-        inside = (z > 0) & (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
-        ui, vi = np.where(inside, u, 0), np.where(inside, v, 0)
-        measured = depths[camera.name][vi, ui]
+        inside, ui, vi, z, measured = _measured_at(centres, camera, depths[camera.name])
         blocked = (measured > 0) & (measured < z - radius - margin) & (owners[camera.name][vi, ui] != track_id)
         hidden &= ~inside | blocked
-    per_part = np.bincount(np.repeat(capsule_part, n), weights=hidden, minlength=num_parts)
+    return _most_of_part(hidden, capsule_part, num_parts, n)
+
+
+def parts_seen_through(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsule_part: np.ndarray, num_parts: int,
+                       depths: Mapping[str, np.ndarray], cameras: Sequence[Camera],
+                       n: int = OcclusionConfig.spheres, margin: float = OcclusionConfig.margin) -> np.ndarray:
+    """Which parts have more than half of their spheres seen through by some camera: the
+    sphere projects into its image onto a pixel whose measured surface lies beyond the
+    sphere's back (its centre plus the capsule's radius there) by more than ``margin``. No
+    body is there, whoever's pixel it is. A pixel without a measurement sees through nothing.
+
+    The arguments are those of :func:`hidden_parts_in_views`. Returns (num_parts,) bool.
+    """
+    centres, radius = _spheres(a, b, radii, n)
+    through = np.zeros(len(centres), bool)
+    for camera in cameras:
+        inside, _, _, z, measured = _measured_at(centres, camera, depths[camera.name])
+        through |= inside & (measured > z + radius + margin)
+    return _most_of_part(through, capsule_part, num_parts, n)
+
+
+def _spheres(a: np.ndarray, b: np.ndarray, radii: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(C * n, 3) centres of ``n`` spheres along each capsule's axis (metres) and (C * n,) their radii."""
+    t = (np.arange(n) + 0.5) / n
+    centres = (a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]).reshape(-1, 3)
+    return centres, (radii[:, :1] + t[None, :] * (radii[:, 1:] - radii[:, :1])).reshape(-1)
+
+
+def _measured_at(points: np.ndarray, camera: Camera, depth: np.ndarray):
+    """Where points (N, 3) fall in ``camera``'s (H, W) ``depth`` (metres): (inside (N,) bool,
+    their pixel's column and row (N,) int (0 outside), their depth along the optical axis
+    (N,) metres, the depth measured at their pixel (N,) metres)."""
+    uv, z = pixels_from_points(points, camera)
+    uv = np.round(np.nan_to_num(uv, nan=-1.0, posinf=-1.0, neginf=-1.0))
+    u, v = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
+    inside = (z > 0) & (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
+    ui, vi = np.where(inside, u, 0), np.where(inside, v, 0)
+    return inside, ui, vi, z, depth[vi, ui]
+
+
+def _most_of_part(flags: np.ndarray, capsule_part: np.ndarray, num_parts: int, n: int) -> np.ndarray:
+    """(num_parts,) bool: the parts with more than half of their spheres (``n`` per capsule) flagged."""
+    per_part = np.bincount(np.repeat(capsule_part, n), weights=flags, minlength=num_parts)
     total = np.bincount(np.repeat(capsule_part, n), minlength=num_parts)
     return per_part > 0.5 * np.maximum(total, 1)
 

@@ -40,7 +40,8 @@ from occupose.grid.pixels import PersonPixels
 from occupose.grid.tracking import TrackState
 from occupose.likelihood import Observation, observation_from_views, point_distances
 from occupose.pose.estimator import PoseEstimator
-from occupose.pose.occlusion import OcclusionState, hidden_parts_in_views, joint_parts, part_tree, planted_legs
+from occupose.pose.occlusion import (OcclusionState, hidden_parts_in_views, joint_parts, part_tree, parts_seen_through,
+                                     planted_legs)
 from occupose.pose.problem import PoseProblem
 from occupose.pose.proposals import feet, unexplained_points
 from occupose.pose.search import best_sample, explained_share, start_candidates, start_spread
@@ -150,10 +151,9 @@ class Person:
             if self.occlusion.suspended:  # kept, not estimated: walks on, or stays with its blob
                 # (at the image's edge it stays with its blob: the camera cannot show it walk on)
                 start = config.start
-                if (np.hypot(*self.step()) * self.fps > config.carry.walk_from
-                        and not at_border(pixels, self.cameras, start.border_px, start.border_count)):
-                    self.carry()
-                else:
+                if not (np.hypot(*self.step()) * self.fps > config.carry.walk_from
+                        and not at_border(pixels, self.cameras, start.border_px, start.border_count)
+                        and self.carry(depths)):
                     self.pose, self.lost = moved, True
                 return self.estimate(False)
             active, scale = self.occlusion.active_dofs(), self.occlusion.diffusion_scale()
@@ -449,22 +449,35 @@ class Person:
             return np.zeros(2)
         return step * min(1.0, carry.max_speed / max(float(np.hypot(*step)), 1e-12))
 
-    def carry(self) -> None:
+    def carry(self, depths: Mapping[str, np.ndarray]) -> bool:
         """A frame without an estimate (gone or suspended): the pose walks on at :meth:`step`;
         at a walker's speed (above ``carry.walk_from``) it comes back where it was carried to
         (:meth:`come_back`), and its legs (``carry.stand_dofs``, and their occlusion memory)
         stand, the feet under the hips: a stride frozen while the walk goes on out of sight
         is a whole step off at every other step, where the middle of a gait cycle is at most
-        half a step off."""
+        half a step off. Unless a camera sees through where its torso would walk to
+        (:func:`occupose.pose.occlusion.parts_seen_through` in this frame's ``depths``, camera
+        name -> (H, W) float32 metres): nobody is there, so the walk out of sight has
+        stopped; the pose then stays where it is. Returns whether it walked on (a step of 0
+        is a walk)."""
         step = self.step()
-        self.pose = self.pose.copy()
-        self.pose[:2] += step
+        pose = self.pose.copy()
+        pose[:2] += step
         self.lost = True
+        model = self.model
+        a, b = capsules_from_poses(model, pose[None])
+        if np.any(step) and parts_seen_through(a[0], b[0], model.capsule_radii, model.capsule_part, model.num_parts,
+                                               depths, self.cameras, self.config.occlusion.spheres,
+                                               self.config.occlusion.margin)[model.part_names.index("torso")]:
+            self.walked_on = False
+            return False
+        self.pose = pose
         self.walked_on = float(np.hypot(*step)) * self.fps > self.config.carry.walk_from
         if self.walked_on:
             self.pose[self.legs] = self.stance[self.legs]
             if self.occlusion is not None:
                 self.occlusion.memory[self.legs] = self.stance[self.legs]
+        return True
 
     def come_back(self, centroid: np.ndarray) -> None:
         """Back after being gone or suspended: start again at the blob's ``centroid`` (3,)
