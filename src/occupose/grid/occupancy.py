@@ -652,11 +652,7 @@ class OccupancyGrid:
                                  f"got {hold.dtype} {hold.shape}")
             hold = np.ascontiguousarray(hold).reshape(-1)
         if self.no_return < 1.0:
-            run = self._missing_run
-            run += 1
-            run[(self._depth > 0.0) & (self._depth < np.inf)] = 0
-            np.minimum(run, self.no_return_after, out=run)
-            np.greater_equal(run, self.no_return_after, out=self._returnless)
+            _kernels.count_missing(self._depth, self._missing_run, self.no_return_after, self._returnless)
         self.stepped = _kernels.update_grid(
             self.spec.shape[0], self._pixels, self._depths_l, self._widths, self._offsets, self._depth,
             self._returnless, self._half_extents, self._fars, self.p_occ, self.p_free, self.no_return, self.transition,
