@@ -44,6 +44,14 @@ def test_a_warm_up_runs_once_per_settings(tmp_path):
     assert len(told) == 1  # nothing said when nothing is done
 
 
+def test_a_warm_up_with_measured_noise_measures_its_scenes_noise(tmp_path):
+    """The tracker refuses measured noise without a measurement: the warm-up measures its
+    own scene's, as a run measures its recording's (it failed every `occupose track` with
+    ``--set grid.noise_model=measured`` before)."""
+    measured = method_config("ours").with_values({"grid.noise_model": "measured", "grid.noise_frames": 5})
+    assert warm_up(measured, [FRONT], folder=tmp_path, load=True) is True
+
+
 # In a process of its own, so that only its warm-up has called the kernels: after it, tracking
 # recordings of other scenes (two people; legs hidden by a couch, which the occlusion test
 # looks for with many candidate poses; a ceiling camera) adds no compiled
