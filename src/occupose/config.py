@@ -310,6 +310,10 @@ class CarryConfig(_Section):
                                         "only at later_speed", "s", low=0)
     later_speed: float = setting(0.7, "speed above which a person is turned round after start_check_s", "m/s",
                                  low=0)
+    upright: float = setting(0.85, "a move counts as a walk (for the turn round and the walking prior) only "
+                                   "while the pelvis stays at least this share of its standing height over the "
+                                   "frames measured: a person sitting down steps backwards", "share",
+                             low=0, high=1)
     walk_frames: int = setting(15, "frames over which the way walked is measured for the walking prior",
                                "frames", low=2)
     walk_prior: float = setting(1.0, "what facing backwards costs at full walking speed", "nats", low=0)

@@ -14,17 +14,24 @@ def _person(model, **kw):
     return Person(model, TrackerConfig(), 30.0, np.random.default_rng(0), (), **kw)
 
 
+def _walk(person, path, heights=None):
+    """Give ``person`` the pelvis path (list of (2,) x, y) of its last estimates, at the
+    pelvis ``heights`` (default: its standing height all along)."""
+    person.path = list(path)
+    person.heights = [float(person.stance[2])] * len(path) if heights is None else list(heights)
+
+
 def test_a_person_walking_faces_the_way_it_walks_standing_still_no_prior():
     person = _person(body_model("full"))
     assert person.walking() is None and not person.standing()  # no path yet: neither
-    person.path = [np.array([0.0, 0.04 * i]) for i in range(CARRY.walk_frames)]  # 1.2 m/s along +y
+    _walk(person, [np.array([0.0, 0.04 * i]) for i in range(CARRY.walk_frames)])  # 1.2 m/s along +y
     direction, weight = person.walking()
     assert direction == pytest.approx(np.pi / 2) and weight == pytest.approx(CARRY.walk_prior)
     assert not person.standing()
-    person.path = [np.array([-0.02 * i, 0.0]) for i in range(CARRY.walk_frames)]  # 0.6 m/s along -x
+    _walk(person, [np.array([-0.02 * i, 0.0]) for i in range(CARRY.walk_frames)])  # 0.6 m/s along -x
     direction, weight = person.walking()
     assert abs(direction) == pytest.approx(np.pi) and weight == pytest.approx(CARRY.walk_prior * (0.6 - CARRY.walk_from) / CARRY.walk_ramp)
-    person.path = [np.array([0.01 * i, 0.0]) for i in range(CARRY.walk_frames)]  # 0.3 m/s: standing, swaying
+    _walk(person, [np.array([0.01 * i, 0.0]) for i in range(CARRY.walk_frames)])  # 0.3 m/s: standing, swaying
     assert person.walking() is None and person.standing()
 
 
@@ -34,7 +41,7 @@ def test_a_person_run_backwards_faces_the_way_its_path_comes_from():
     way it faces."""
     model = body_model("full")
     person = _person(model, backwards=True)
-    person.path = [np.array([0.0, 0.04 * i]) for i in range(CARRY.walk_frames)]  # +y back in time
+    _walk(person, [np.array([0.0, 0.04 * i]) for i in range(CARRY.walk_frames)])  # +y back in time
     direction, weight = person.walking()
     assert direction == pytest.approx(-np.pi / 2) and weight == pytest.approx(CARRY.walk_prior)
     pose = standing_pose(model, (0.0, 0.0), np.pi / 2)  # facing +y
@@ -55,10 +62,31 @@ def test_a_person_walking_backwards_is_turned_round_at_the_start_or_when_walking
     pose = standing_pose(model, (0.0, 0.0), 0.0)
     person.estimator.initialise(pose, 0.0)
     person.pose, person.estimates, person.since_turn = pose, estimates, CARRY.frames
-    person.path = [np.array([-speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)]
+    _walk(person, [np.array([-speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)])
     person.face_the_way_walked()
     heading = person.pose[model.dof_names.index("heading")]
     assert abs(abs(heading) - np.pi) < 1e-9 if turned else heading == 0.0
+
+
+@pytest.mark.parametrize("lowest, moves", [(0.95, True), (0.86, True), (0.84, False), (0.65, False)])
+def test_only_an_upright_person_walks(lowest, moves):
+    """A person sitting down steps backwards at walking speed (0.3-0.7 m/s on the randomized
+    benchmark's procedural sitting) while its pelvis drops: with the pelvis below
+    CARRY.upright of its standing height at some estimate of the window, the move is no walk,
+    so it neither turns the estimate round to face the seat nor weighs the walking prior."""
+    assert CARRY.upright == 0.85
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.0)  # facing +x
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.estimates, person.since_turn = pose, 10, CARRY.frames
+    standing = float(person.stance[2])
+    heights = np.linspace(standing, lowest * standing, CARRY.frames)  # the pelvis drops as it goes
+    _walk(person, [np.array([-0.7 / 30.0 * i, 0.0]) for i in range(CARRY.frames)], heights)  # backwards
+    assert (person.walking() is not None) == moves
+    person.face_the_way_walked()
+    heading = person.pose[model.dof_names.index("heading")]
+    assert abs(abs(heading) - np.pi) < 1e-9 if moves else heading == 0.0
 
 
 def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
@@ -67,7 +95,7 @@ def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     pose = standing_pose(model, (0.0, 0.0), 0.0)
     person.estimator.initialise(pose, 0.0)
     person.pose, person.centroid = pose, np.array([0.0, 0.0, 1.0])
-    person.path = [np.array([0.04 * i, 0.0]) for i in range(CARRY.walk_frames)]  # 1.2 m/s along +x
+    _walk(person, [np.array([0.04 * i, 0.0]) for i in range(CARRY.walk_frames)])  # 1.2 m/s along +x
     person.lost = True
     person.come_back(np.array([2.0, 1.0, 1.0]))  # back at another blob after a gap
     assert not person.lost
@@ -95,7 +123,7 @@ def test_a_person_carried_out_of_sight_at_a_walk_stands_its_legs(speed):
     person.estimator.initialise(stride, 0.0)
     person.pose, person.centroid = stride.copy(), np.array([0.0, 0.0, 1.0])
     person.occlusion.memory = stride.copy()
-    person.path = [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)]
+    _walk(person, [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)])
     person.carry({})
     legs = np.array([n.startswith(CARRY.stand_dofs) for n in model.dof_names])
     assert legs.sum() == 8 and person.walked_on == (speed > CARRY.walk_from)
@@ -220,7 +248,7 @@ def test_a_person_carried_into_space_a_camera_sees_through_stays():
         pose = standing_pose(model, (0.0, 0.0), 0.0)
         person.estimator.initialise(pose, 0.0)
         person.pose, person.centroid = pose.copy(), np.array([0.0, 0.0, 1.0])
-        person.path = [np.array([0.04 * i, 0.0]) for i in range(CARRY.frames)]  # 1.2 m/s along +x
+        _walk(person, [np.array([0.04 * i, 0.0]) for i in range(CARRY.frames)])  # 1.2 m/s along +x
         image = np.full((camera.height, camera.width), depth, np.float32)
         assert person.carry({"front": image}) == walks and person.lost
         np.testing.assert_allclose(person.pose[:2], [0.04, 0.0] if walks else [0.0, 0.0])
