@@ -235,7 +235,8 @@ class Tracker:
             return None
         rng = np.random.default_rng(self._seeds.spawn(1)[0])
         person = start_person(np.concatenate(self._pending.pop(tid)), pixels, depths, centroid, velocity,
-                              self.cameras, self.model_name, self.config, self.fps, rng)
+                              self.cameras, self.model_name, self.config, self.fps, rng,
+                              area=(np.asarray(self.spec.origin[:2]), self.spec.high[:2]))
         person.blob = tid
         self.people[tid] = person
         return person

@@ -4,14 +4,19 @@ import numpy as np
 import pytest
 
 from occupose.body import body_model, standing_pose
+from occupose.camera import camera_preset, look_at
 from occupose.config import CarryConfig, TrackerConfig
 from occupose.pose.person import Person
 
 CARRY = CarryConfig()
+#: A camera 3 m in front of the origin, seeing 1.5 m to the right of it there, and a
+#: frame of it without measurements (which sees through nothing: a carried person walks on).
+FRONT = camera_preset("kinect_v1", world_from_camera=look_at((0.0, -3.0, 1.5), (0.0, 0.0, 1.0)), camera_name="front")
+NOTHING = {"front": np.zeros((FRONT.height, FRONT.width), np.float32)}
 
 
 def _person(model, **kw):
-    return Person(model, TrackerConfig(), 30.0, np.random.default_rng(0), (), **kw)
+    return Person(model, TrackerConfig(), 30.0, np.random.default_rng(0), (FRONT,), **kw)
 
 
 def _walk(person, path, heights=None):
@@ -97,15 +102,15 @@ def test_a_person_back_from_a_gap_walks_on_the_way_it_walked_before():
     person.pose, person.centroid = pose, np.array([0.0, 0.0, 1.0])
     _walk(person, [np.array([0.04 * i, 0.0]) for i in range(CARRY.walk_frames)])  # 1.2 m/s along +x
     person.lost = True
-    person.come_back(np.array([2.0, 1.0, 1.0]))  # back at another blob after a gap
+    person.come_back(np.array([1.0, 1.0, 1.0]))  # back at another blob after a gap
     assert not person.lost
-    np.testing.assert_allclose(person.pose[:2], [2.0, 1.0])
-    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [2.0, 1.0])
-    np.testing.assert_allclose(person.path[-1], [2.0, 1.0])  # the jump is no step: same way, same speed
+    np.testing.assert_allclose(person.pose[:2], [1.0, 1.0])
+    np.testing.assert_allclose(person.estimator.filter.estimate[:2], [1.0, 1.0])
+    np.testing.assert_allclose(person.path[-1], [1.0, 1.0])  # the jump is no step: same way, same speed
     direction, weight = person.walking()
     assert direction == pytest.approx(0.0) and weight == pytest.approx(CARRY.walk_prior)
-    person.carry({})  # hidden again at once: carried on along +x (no camera sees through it)
-    np.testing.assert_allclose(person.pose[:2], [2.04, 1.0])
+    person.carry(NOTHING)  # hidden again at once: carried on along +x (no camera sees through it)
+    np.testing.assert_allclose(person.pose[:2], [1.04, 1.0])
 
 
 @pytest.mark.parametrize("speed", [1.2, 0.3])
@@ -124,7 +129,7 @@ def test_a_person_carried_out_of_sight_at_a_walk_stands_its_legs(speed):
     person.pose, person.centroid = stride.copy(), np.array([0.0, 0.0, 1.0])
     person.occlusion.memory = stride.copy()
     _walk(person, [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)])
-    person.carry({})
+    person.carry(NOTHING)
     legs = np.array([n.startswith(CARRY.stand_dofs) for n in model.dof_names])
     assert legs.sum() == 8 and person.walked_on == (speed > CARRY.walk_from)
     rest = standing_pose(model) if person.walked_on else stride
@@ -158,7 +163,7 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     for i in range(5):  # partly hidden: the estimate slows to 0.3 m/s, the blob stalls
         person.settle(pose + np.eye(model.num_dofs)[0] * (0.18 + 0.01 * (i + 1)), np.array([0.2, 0.0]))
     np.testing.assert_allclose(person.step(), [0.04, 0.0])
-    person.carry({})
+    person.carry(NOTHING)
     np.testing.assert_allclose(person.pose[:2], [0.27, 0.0])
     assert person.walked_on  # carried at 1.2 m/s: it comes back there, not on its blob
     person.come_back(np.array([0.9, 0.3, 1.0]))
@@ -168,7 +173,7 @@ def test_a_person_walking_behind_a_cabinet_is_carried_at_its_speed_in_full_view(
     for _ in range(CARRY.frames):  # standing partly hidden for long: its own recent path again
         person.settle(person.pose, np.array([0.3, 0.0]))
     np.testing.assert_allclose(person.step(), [0.0, 0.0], atol=1e-12)
-    person.carry({})
+    person.carry(NOTHING)
     assert not person.walked_on  # carried standing: it comes back on its blob
     person.come_back(np.array([0.9, 0.3, 1.0]))
     np.testing.assert_allclose(person.pose[:2], np.array([0.9, 0.3]) + person.anchor)
@@ -238,13 +243,10 @@ def test_a_person_carried_into_space_a_camera_sees_through_stays():
     """Carried at a walk, a person walks on behind something (the camera measures a surface
     in front of where its torso goes), but not into space the camera sees through (a
     surface measured beyond it): nobody is there, so the walk out of sight has stopped."""
-    from occupose.camera import camera_preset, look_at
-
-    camera = camera_preset("kinect_v1", world_from_camera=look_at((0.0, -3.0, 1.5), (0.0, 0.0, 1.0)),
-                           camera_name="front")
+    camera = FRONT
     model = body_model("full")
     for depth, walks in ((1.0, True), (6.0, False)):  # a cabinet 1 m from the camera; a wall 6 m away
-        person = Person(model, TrackerConfig(), 30.0, np.random.default_rng(0), (camera,))
+        person = _person(model)
         pose = standing_pose(model, (0.0, 0.0), 0.0)
         person.estimator.initialise(pose, 0.0)
         person.pose, person.centroid = pose.copy(), np.array([0.0, 0.0, 1.0])
@@ -255,3 +257,33 @@ def test_a_person_carried_into_space_a_camera_sees_through_stays():
         assert person.walked_on == walks
         holes = np.zeros_like(image)  # no measurement sees through nothing: it walks on
         assert person.carry({"front": holes})
+
+
+@pytest.mark.parametrize("x, walks", [(0.0, True), (1.4, True), (1.5, False)])
+def test_a_person_carried_out_of_every_cameras_image_stays(x, walks):
+    """Out of every camera's image is not hidden: a person carried there would walk on
+    for ever (an estimate slid off a person standing still was carried out of the room and
+    on behind the camera while its blob stayed). FRONT sees 1.52 m to the right at the
+    person's distance: a step of 4 cm along +x from x = 1.5 m takes the torso out."""
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (x, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.centroid = pose.copy(), np.array([x, 0.0, 1.0])
+    _walk(person, [np.array([x + 0.04 * i - 0.56, 0.0]) for i in range(CARRY.frames)])  # 1.2 m/s along +x
+    assert person.carry(NOTHING) == walks and person.walked_on == walks
+    np.testing.assert_allclose(person.pose[:2], [x + 0.04, 0.0] if walks else [x, 0.0])
+
+
+def test_a_person_is_not_carried_out_of_the_watched_area():
+    """Nor out of the floor area the cameras watch (the grid's, beyond which they measure
+    nothing of anyone): a walker behind a back wall is not there."""
+    model = body_model("full")
+    for high, walks in ((1.0, True), (0.02, False)):
+        person = _person(model, area=(np.array([-1.0, -1.0]), np.array([high, 1.0])))
+        pose = standing_pose(model, (0.0, 0.0), 0.0)
+        person.estimator.initialise(pose, 0.0)
+        person.pose, person.centroid = pose.copy(), np.array([0.0, 0.0, 1.0])
+        _walk(person, [np.array([0.04 * i - 0.56, 0.0]) for i in range(CARRY.frames)])  # 1.2 m/s along +x
+        assert person.carry(NOTHING) == walks
+        np.testing.assert_allclose(person.pose[:2], [0.04 if walks else 0.0, 0.0])

@@ -86,7 +86,7 @@ class LookBack:
         blob's ``velocity`` (2,) m/s now, reversed), the frames before its start only."""
         tid, out = person.blob, []
         back = Person(person.model, self.config, self.fps, np.random.default_rng(self.seeds.spawn(1)[0]),
-                      self.cameras, backwards=True)
+                      self.cameras, backwards=True, area=person.area)
         back.estimator.initialise(person.pose, start_spread(person.model, self.config.start))
         back.centroid, back.blob = person.centroid, tid
         back.settle(person.pose, -velocity)

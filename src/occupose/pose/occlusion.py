@@ -267,15 +267,35 @@ def _spheres(a: np.ndarray, b: np.ndarray, radii: np.ndarray, n: int) -> tuple[n
     return centres, (radii[:, :1] + t[None, :] * (radii[:, 1:] - radii[:, :1])).reshape(-1)
 
 
-def _measured_at(points: np.ndarray, camera: Camera, depth: np.ndarray):
-    """Where points (N, 3) fall in ``camera``'s (H, W) ``depth`` (metres): (inside (N,) bool,
-    their pixel's column and row (N,) int (0 outside), their depth along the optical axis
-    (N,) metres, the depth measured at their pixel (N,) metres)."""
+def parts_out_of_view(a: np.ndarray, b: np.ndarray, radii: np.ndarray, capsule_part: np.ndarray, num_parts: int,
+                      cameras: Sequence[Camera], n: int = OcclusionConfig.spheres) -> np.ndarray:
+    """Which parts have more than half of their spheres outside every camera's image (beside
+    it, or behind the camera): no camera could see them there, whatever the depths say.
+
+    The arguments are those of :func:`hidden_parts_in_views`. Returns (num_parts,) bool.
+    """
+    centres, _ = _spheres(a, b, radii, n)
+    inside = np.zeros(len(centres), bool)
+    for camera in cameras:
+        inside |= _in_image(centres, camera)[0]
+    return _most_of_part(~inside, capsule_part, num_parts, n)
+
+
+def _in_image(points: np.ndarray, camera: Camera):
+    """Where points (N, 3) fall in ``camera``'s image: (inside (N,) bool, their pixel's
+    column and row (N,) int (0 outside), their depth along the optical axis (N,) metres)."""
     uv, z = pixels_from_points(points, camera)
     uv = np.round(np.nan_to_num(uv, nan=-1.0, posinf=-1.0, neginf=-1.0))
     u, v = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
     inside = (z > 0) & (u >= 0) & (u < camera.width) & (v >= 0) & (v < camera.height)
-    ui, vi = np.where(inside, u, 0), np.where(inside, v, 0)
+    return inside, np.where(inside, u, 0), np.where(inside, v, 0), z
+
+
+def _measured_at(points: np.ndarray, camera: Camera, depth: np.ndarray):
+    """Where points (N, 3) fall in ``camera``'s (H, W) ``depth`` (metres): :func:`_in_image`'s
+    (inside, column, row, depth along the optical axis) and the depth measured at their
+    pixel (N,) metres."""
+    inside, ui, vi, z = _in_image(points, camera)
     return inside, ui, vi, z, depth[vi, ui]
 
 

@@ -40,8 +40,8 @@ from occupose.grid.pixels import PersonPixels
 from occupose.grid.tracking import TrackState
 from occupose.likelihood import Observation, observation_from_views, point_distances
 from occupose.pose.estimator import PoseEstimator
-from occupose.pose.occlusion import (OcclusionState, hidden_parts_in_views, joint_parts, part_tree, parts_seen_through,
-                                     planted_legs)
+from occupose.pose.occlusion import (OcclusionState, hidden_parts_in_views, joint_parts, part_tree, parts_out_of_view,
+                                     parts_seen_through, planted_legs)
 from occupose.pose.problem import PoseProblem
 from occupose.pose.proposals import feet, unexplained_points
 from occupose.pose.search import best_sample, explained_share, start_candidates, start_spread
@@ -68,14 +68,18 @@ class Person:
     rng : its own random generator; cameras : the recording's cameras
     backwards : it runs back in time (the look-back, :mod:`occupose.pose.lookback`): it
         walks the other way, so its walking prior and turn-round test flip
+    area : None or (low (2,), high (2,)), world x, y metres: the floor area the cameras
+        watch (the occupancy grid's), out of which it is not carried (:meth:`carry`)
     """
 
     def __init__(self, model: BodyModel, config: TrackerConfig, fps: float, rng: np.random.Generator,
-                 cameras: Sequence[Camera], *, backwards: bool = False):
+                 cameras: Sequence[Camera], *, backwards: bool = False,
+                 area: tuple[np.ndarray, np.ndarray] | None = None):
         self.model = model
         self.config = config
         self.cameras = tuple(cameras)
         self.backwards = backwards
+        self.area = None if area is None else (np.asarray(area[0], float), np.asarray(area[1], float))
         pose = config.pose
         self.problem = PoseProblem(model, pose.likelihood, fps=fps,
                                    diffusion=diffusion_scales(model, fps, per_kind=dataclasses.asdict(config.diffusion)),
@@ -472,17 +476,25 @@ class Person:
         half a step off. Unless a camera sees through where its torso would walk to
         (:func:`occupose.pose.occlusion.parts_seen_through` in this frame's ``depths``, camera
         name -> (H, W) float32 metres): nobody is there, so the walk out of sight has
-        stopped; the pose then stays where it is. Returns whether it walked on (a step of 0
-        is a walk)."""
+        stopped; the pose then stays where it is. Nor out of every camera's image (beside it
+        or behind the camera, :func:`occupose.pose.occlusion.parts_out_of_view`), nor out of
+        the watched ``area`` (beyond the cameras' range): out of sight there is not hidden,
+        and nothing would ever stop the walk (an estimate that slid off a person standing
+        still was carried out of the room, and on behind the camera, for 140 frames while
+        its blob stayed; another on through the back wall). Returns whether it walked on (a
+        step of 0 is a walk)."""
         step = self.step()
         pose = self.pose.copy()
         pose[:2] += step
         self.lost = True
         model = self.model
         a, b = capsules_from_poses(model, pose[None])
-        if np.any(step) and parts_seen_through(a[0], b[0], model.capsule_radii, model.capsule_part, model.num_parts,
-                                               depths, self.cameras, self.config.occlusion.spheres,
-                                               self.config.occlusion.margin)[model.part_names.index("torso")]:
+        torso, spheres = model.part_names.index("torso"), self.config.occlusion.spheres
+        outside = self.area is not None and not np.all((pose[:2] >= self.area[0]) & (pose[:2] <= self.area[1]))
+        if np.any(step) and (outside or parts_seen_through(a[0], b[0], model.capsule_radii, model.capsule_part, model.num_parts,
+                                                depths, self.cameras, spheres, self.config.occlusion.margin)[torso]
+                             or parts_out_of_view(a[0], b[0], model.capsule_radii, model.capsule_part,
+                                                  model.num_parts, self.cameras, spheres)[torso]):
             self.walked_on = False
             return False
         self.pose = pose

@@ -131,16 +131,17 @@ def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera, c
 
 def start_person(points: np.ndarray, pixels: PersonPixels, depths: Mapping[str, np.ndarray], centroid: np.ndarray,
                  velocity: np.ndarray, cameras: Sequence[Camera], model_name: str, config: TrackerConfig, fps: float,
-                 rng: np.random.Generator) -> Person:
+                 rng: np.random.Generator, area: tuple[np.ndarray, np.ndarray] | None = None) -> Person:
     """A new person from its blob's pooled points (N, 3) world metres (its size) and this
     frame's ``pixels``: the best start candidate, settled by ``start.steps`` filter steps.
 
     depths : camera name -> (H, W) float32 metres; centroid : (3,) metres, the blob's
     centroid this frame; velocity : (2,) m/s, its track's horizontal velocity;
-    model_name : "full" or "upper"; rng : the person's random generator
+    model_name : "full" or "upper"; rng : the person's random generator; area : as
+    :class:`occupose.pose.person.Person`'s
     """
     size = dims_from_observation(points, size=config.size)
-    person = Person(body_model(model_name, size.dims, size.girth), config, fps, rng, cameras)
+    person = Person(body_model(model_name, size.dims, size.girth), config, fps, rng, cameras, area=area)
     best, _ = search_start(person, pixels, depths, velocity, cameras, config.start.steps)
     person.centroid = np.asarray(centroid, float)
     person.settle(best, velocity)
