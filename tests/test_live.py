@@ -77,6 +77,19 @@ def test_a_synthetic_bag_plays_as_a_camera_and_its_person_is_tracked(walk_bag):
     assert np.median(errors) < 0.10, errors  # metres
 
 
+def test_live_with_measured_noise_measures_it_on_the_first_frames(walk_bag):
+    """grid.noise_model measured: the camera's noise is measured on its next frames (after
+    the pose), which are not tracked, and the tracker takes it (it refuses to run without)."""
+    bag, scene, pose = walk_bag
+    out, said = io.StringIO(), []
+    measured = method_config("ours").with_values({"grid.noise_model": "measured", "grid.noise_frames": 5})
+    with RealSenseCamera(bag=bag) as source:
+        summary = track_live(source, measured, out=out, pose=pose, status=said.append)
+    lines = [json.loads(line) for line in out.getvalue().splitlines()]
+    assert "measuring the camera's depth noise over its next 5 frames" in said
+    assert summary.frames == len(lines) > 0 and lines[0]["device_frame"] > 5  # the first five were measured
+
+
 def test_a_tracker_slower_than_the_camera_drops_frames_and_says_so(walk_bag):
     """With ten times the particles the tracker cannot keep up with 30 frames/s: it takes the
     newest frame each time and counts the others."""

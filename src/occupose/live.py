@@ -19,6 +19,7 @@ used only for that.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import time
@@ -209,9 +210,17 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
     config = as_config(config)
     frames = source.frames()
     camera, origin = _place(source.camera, frames, pose, config)
+    noise = None
+    if config.grid.noise_model == "measured":  # as track_recording: from the camera's next frames
+        from occupose.grid.noise import measure_noise
+
+        if status is not None:
+            status(f"measuring the camera's depth noise over its next {config.grid.noise_frames} frames")
+        first = itertools.islice(frames, config.grid.noise_frames)
+        noise = measure_noise([camera], ({camera.name: frame.depth} for frame in first), config.grid)
     source.pause()  # a played bag waits for the warm-up; a camera's frames meanwhile are dropped
     warmup.warm_up(config, [camera], report=status, load=True)
-    tracker = Tracker([camera], source.fps, config, seed=seed)
+    tracker = Tracker([camera], source.fps, config, seed=seed, noise=noise)
     source.resume()
     summary = LiveSummary(pose=origin)
     offset = math.inf  # host clock minus device clock (s), least over the frames: the least delayed one's
