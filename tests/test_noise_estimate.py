@@ -161,3 +161,28 @@ def test_a_depth_bin_mostly_crossed_by_a_mover_is_left_out():
     assert not np.any((estimate.bin_depths >= 2.5) & (estimate.bin_depths < 2.75)), estimate.bin_depths
     for z in (1.8, 2.6, 3.0):
         assert estimate.std(z) == pytest.approx(2.0 * depth_std(z, "tof"), rel=0.2)
+
+
+def test_a_tracker_given_no_measurement_measures_the_noise_on_its_first_frames():
+    """grid.noise_model measured, no ``noise=``: the named model for the first
+    grid.noise_frames frames, then the measured noise, the grid made again and those frames
+    replayed through it: its beliefs are then those of a tracker given the same measurement
+    from the start (nobody has started yet, so no hold differs), and it tracks on."""
+    from occupose.tracker import Tracker
+
+    scenario = build_scenario("no_occlusion", use_mocap=False, sensor="kinect_v2")
+    depths = [f.depth for f in frames(scenario, seed=0, num_frames=8)]
+    config = TrackerConfig().with_values({"grid.noise_model": "measured", "grid.noise_frames": 4})
+    itself = Tracker(scenario.cameras, scenario.fps, config)
+    assert itself.noise["front"].model == "tof"  # named, until measured
+    given = Tracker(scenario.cameras, scenario.fps, config, noise=measure_noise(scenario.cameras, depths, config.grid))
+    for index, frame in enumerate(depths[:4]):
+        itself.update(frame)
+        given.update(frame)
+        assert itself.noise["front"].model == "tof" if index < 3 else isinstance(itself.noise["front"].model,
+                                                                                 NoiseEstimate)
+    assert itself.noise["front"].to_dict() == given.noise["front"].to_dict()
+    np.testing.assert_allclose(itself.grid.probabilities, given.grid.probabilities, atol=1e-6)
+    assert not itself.people and not given.people
+    for frame in depths[4:]:
+        itself.update(frame)

@@ -29,6 +29,7 @@ Every setting is a field of :class:`occupose.config.TrackerConfig`.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -88,8 +89,13 @@ class Tracker:
     seed : int, seeds every person's filter (person n gets a generator spawned from it)
     noise : None or camera name -> :class:`occupose.sensors.NoiseEstimate`, each camera's
         measured depth noise (:func:`occupose.grid.noise.measure_noise` of the first
-        ``grid.noise_frames`` frames; :func:`occupose.run.track_recording` does it); needed
-        with ``grid.noise_model`` measured. ``noise`` (after construction): camera name ->
+        ``grid.noise_frames`` frames; :func:`occupose.run.track_recording` and
+        :func:`occupose.live.track_live` measure it before the first frame), used with
+        ``grid.noise_model`` measured. Without it, the tracker measures it itself on its
+        first ``grid.noise_frames`` frames, which it tracks meanwhile with each camera's
+        named noise model (as ``grid.noise_model`` none); it then replays them through a
+        grid made with the measured noise, and goes on with that grid (and the people it
+        has). ``noise`` (after construction): camera name ->
         :class:`occupose.grid.noise.CameraNoise`, what the grid assumes of each camera.
     """
 
@@ -105,15 +111,14 @@ class Tracker:
         pose = config.pose
         self.model_name = model_for(cameras, pose.steep_down_deg) if pose.model == "auto" else pose.model
         grid = config.grid
-        self.noise = camera_noise(cameras, grid, noise)
-        far = {name: c.max_range for name, c in self.noise.items()}
-        check_reach(cameras, far, limits)
-        self.spec = spec_from_cameras(cameras, cell=grid.cell, height=grid.height, max_range=far,
-                                      max_cells=limits.grid_cells)
-        self.grid = OccupancyGrid(self.spec, cameras, {name: c.model for name, c in self.noise.items()},
-                                  alpha=grid.alpha, beta=grid.beta, gamma=grid.gamma, psi=grid.psi, p_occ=grid.p_occ,
-                                  p_free=grid.p_free, tail_width=grid.tail_width, initial=grid.initial, max_range=far,
-                                  no_return=grid.no_return, no_return_after=grid.no_return_after)
+        #: the frames (camera name -> depth) the noise is being measured on, or None
+        self._noise_frames: list[dict[str, np.ndarray]] | None = None
+        if grid.noise_model == "measured" and noise is None:
+            self._noise_frames = []
+            self.noise = camera_noise(cameras, dataclasses.replace(grid, noise_model=None))
+        else:
+            self.noise = camera_noise(cameras, grid, noise)
+        self._make_grid()
         blobs = config.blobs
         self.blobs = BlobTracker(self.fps, blobs.max_gap_s, gate_m=blobs.gate_m, gate_growth=blobs.gate_growth,
                                  claim_share=blobs.claim_share, merge_margin_m=blobs.merge_margin_m,
@@ -130,6 +135,43 @@ class Tracker:
         self.frame = -1
         self._pool: ThreadPoolExecutor | None = None  # the grid's thread when updates overlap
         self._grid_job = None
+
+    def _make_grid(self) -> None:
+        """The grid (and its spec) for the cameras' noise and far range of ``self.noise``."""
+        grid, far = self.config.grid, {name: c.max_range for name, c in self.noise.items()}
+        check_reach(self.cameras, far, self.config.limits)
+        self.spec = spec_from_cameras(self.cameras, cell=grid.cell, height=grid.height, max_range=far,
+                                      max_cells=self.config.limits.grid_cells)
+        self.grid = OccupancyGrid(self.spec, self.cameras, {name: c.model for name, c in self.noise.items()},
+                                  alpha=grid.alpha, beta=grid.beta, gamma=grid.gamma, psi=grid.psi, p_occ=grid.p_occ,
+                                  p_free=grid.p_free, tail_width=grid.tail_width, initial=grid.initial, max_range=far,
+                                  no_return=grid.no_return, no_return_after=grid.no_return_after)
+
+    def _seed_still(self, depths: Mapping[str, np.ndarray], frame: int) -> None:
+        """After the grid's update with frame number ``frame``: people still from the first
+        frame are no background (:func:`occupose.pose.start.still_people`)."""
+        if frame < self.config.start.still_frames:
+            self.grid.seed_moving(still_people(self.grid.states, self.spec, depths, self.cameras, self.config.start,
+                                               self.config.size, self.config.blobs.join_m) & ~self.grid.moving_mask())
+
+    def _measure_noise(self, depths: Mapping[str, np.ndarray]) -> None:
+        """Keep this frame for the noise measurement (a Tracker given no ``noise`` with
+        ``grid.noise_model`` measured); with ``grid.noise_frames`` of them, measure, make the
+        grid again with the measured noise and replay them through it (no hold: the
+        people's bodies of those frames are gone)."""
+        from occupose.grid.noise import measure_noise
+
+        self._noise_frames.append({name: np.array(d, np.float32) for name, d in depths.items()})
+        if len(self._noise_frames) < self.config.grid.noise_frames:
+            return
+        frames, self._noise_frames = self._noise_frames, None
+        self.noise = camera_noise(self.cameras, self.config.grid, measure_noise(self.cameras, frames, self.config.grid))
+        self._make_grid()
+        for index, frame in enumerate(frames):
+            self.grid.update(frame)
+            self._seed_still(frame, index)
+        for person in self.people.values():
+            person.area = (np.asarray(self.spec.origin[:2]), self.spec.high[:2])
 
     def _check_views(self, depths: Mapping[str, np.ndarray]) -> None:
         """Each camera's first frame with measurements (:func:`occupose.bounds.check_first_view`)."""
@@ -160,15 +202,15 @@ class Tracker:
         self.frame += 1
         seconds = dict.fromkeys(STAGES, 0.0)
         clock = time.perf_counter()
+        self._check_views(depths)
         if self._grid_job is not None:  # this frame's grid update ran during the last stage 3
             self._grid_job.result()
             self._grid_job = None
         else:
             self.grid.update(depths, hold=self._hold())
-        self._check_views(depths)
-        if self.frame < self.config.start.still_frames:  # people still from the first frame are no background
-            self.grid.seed_moving(still_people(self.grid.states, self.spec, depths, self.cameras, self.config.start,
-                                               self.config.size, self.config.blobs.join_m) & ~self.grid.moving_mask())
+        self._seed_still(depths, self.frame)
+        if self._noise_frames is not None:
+            self._measure_noise(depths)
         clock = _tick(seconds, "grid", clock)
         blobs = self.config.blobs
         labels, found = blobs_from_mask(self.grid.moving_mask(), self.spec, min_cells=blobs.min_cells,
@@ -190,7 +232,7 @@ class Tracker:
                                              centers={t: states[t].centroid for t in seen}, predicted=bodies,
                                              fallback=pixels_cfg.fallback)
         self._previous = pixels
-        if upcoming is not None:
+        if upcoming is not None and self._noise_frames is None:  # (the grid may be made again while measuring)
             if self._pool is None:
                 self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="occupose-grid")
             self._grid_job = self._pool.submit(self.grid.update, upcoming, self._hold())
