@@ -215,11 +215,11 @@ def test_a_filter_given_alone_takes_the_layers_it_accepts(tmp_path, small_camera
 def test_config_command_prints_settings_that_read_back(tmp_path):
     runner = CliRunner()
     result = runner.invoke(main, ["config", "--method", "apf", "--set", "pose.particles=300", "--set",
-                                  "grid.max_range=4.0"])
+                                  "grid.noise_model=preset"])
     assert result.exit_code == 0, result.output
     assert 'method = "apf"' in result.output and "particles = 300" in result.output
-    assert "# noise_model = none" in result.output  # TOML has no none
+    assert 'noise_model = "preset"' in result.output and "# max_range = none" in result.output  # TOML has no none
     path = tmp_path / "printed.toml"
     path.write_text(result.output)
-    expected = TrackerConfig.from_dict({"method": "apf", "pose": {"particles": 300}, "grid": {"max_range": 4.0}})
+    expected = TrackerConfig.from_dict({"method": "apf", "pose": {"particles": 300}, "grid": {"noise_model": "preset"}})
     assert TrackerConfig.from_file(path) == expected

@@ -101,18 +101,21 @@ def test_a_preset_matches_a_calibration_a_few_percent_off_and_nothing_else():
 def test_each_camera_gets_its_own_noise_and_range():
     azure = dataclasses.replace(camera_preset("azure_nfov", camera_name="a"), fx=504.61 * 1.03)  # calibrated
     odd = dataclasses.replace(camera_preset("kinect_v2", camera_name="b"), width=500)  # no preset
-    named = camera_noise([azure, odd], GridConfig())
+    named = camera_noise([azure, odd], GridConfig(noise_model=None))
     assert (named["a"].model, named["a"].max_range, named["a"].preset) == ("tof", 3.86, "azure_nfov")
     assert (named["b"].model, named["b"].max_range, named["b"].preset) == ("structured_light", 4.5, None)
-    assert camera_noise([azure], GridConfig(max_range=3.0))["a"].max_range == 3.0
+    assert camera_noise([azure], GridConfig(noise_model=None, max_range=3.0))["a"].max_range == 3.0
     depths, _ = _static_scene("kinect_v2", 2.0)
     estimate = estimate_depth_noise(depths)
     measured = camera_noise([azure, odd], GridConfig(noise_model="measured"), {"a": estimate, "b": estimate})
     assert measured["a"].model is estimate and measured["a"].max_range == 3.86  # the preset's range
     assert measured["b"].max_range == pytest.approx(estimate.far)  # no preset: the farthest it measured
     assert 4.35 < estimate.far <= 4.5  # the back wall's upper corners, 4.46 m along the optical axis
-    with pytest.raises(ValueError, match=r"measured noise of camera\(s\) \['b'\]"):
-        camera_noise([azure, odd], GridConfig(noise_model="measured"), {"a": estimate})
+    # a camera without an estimate has its named model, and says why
+    some = camera_noise([azure, odd], GridConfig(noise_model="measured"), {"a": estimate, "b": "too few frames"})
+    assert some["a"].model is estimate and (some["b"].model, some["b"].max_range) == ("structured_light", 4.5)
+    assert some["b"].to_dict()["unmeasured"] == "too few frames" and "unmeasured" not in named["b"].to_dict()
+    assert camera_noise([azure], GridConfig(noise_model="measured"))["a"].unmeasured == "not measured"
 
 
 def test_measure_noise_names_the_camera_it_cannot_measure():
@@ -122,6 +125,8 @@ def test_measure_noise_names_the_camera_it_cannot_measure():
     assert estimates[camera.name].frames == 5 and isinstance(estimates[camera.name], NoiseEstimate)
     with pytest.raises(ValueError, match="camera 'cam0': .*at least 3 frames, got 2"):
         measure_noise([camera], first[:2])
+    reason = measure_noise([camera], first[:2], strict=False)[camera.name]  # what a run records instead
+    assert isinstance(reason, str) and "at least 3 frames, got 2" in reason
 
 
 def test_the_measured_path_records_each_cameras_noise_in_the_summary(tmp_path):
@@ -140,7 +145,7 @@ def test_the_measured_path_records_each_cameras_noise_in_the_summary(tmp_path):
     z = 0.5 * (near + far)
     # the recording's depth is whole millimetres: the estimate carries that too
     assert np.polyval(noise["coefficients"][::-1], z) == pytest.approx(depth_std(z, "tof"), rel=0.2)
-    named = track_recording(tmp_path / "rec", TrackerConfig())
+    named = track_recording(tmp_path / "rec", TrackerConfig().with_values({"grid.noise_model": None}))
     assert named.noise["front"] == {"model": "tof", "coefficients": [1.5e-3, -0.5e-3, 0.3e-3], "max_range": 4.5,
                                     "preset": "kinect_v2"}
 

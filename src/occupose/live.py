@@ -217,7 +217,7 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
         if status is not None:
             status(f"measuring the camera's depth noise over its next {config.grid.noise_frames} frames")
         first = itertools.islice(frames, config.grid.noise_frames)
-        noise = measure_noise([camera], ({camera.name: frame.depth} for frame in first), config.grid)
+        noise = measure_noise([camera], ({camera.name: frame.depth} for frame in first), config.grid, strict=False)
     source.pause()  # a played bag waits for the warm-up; a camera's frames meanwhile are dropped
     warmup.warm_up(config, [camera], report=status, load=True)
     tracker = Tracker([camera], source.fps, config, seed=seed, noise=noise)

@@ -159,7 +159,7 @@ def track_recording(recording, config: TrackerConfig | str = "ours", *, seed: in
     noise = None
     if config.grid.noise_model == "measured":
         first = (frame.depth for frame in itertools.islice(recording.frames(color=False), config.grid.noise_frames))
-        noise = measure_noise(recording.cameras, first, config.grid)
+        noise = measure_noise(recording.cameras, first, config.grid, strict=False)
     tracker = Tracker(recording.cameras, recording.fps, config, seed=seed, noise=noise)
     with Prefetch(recording.frames(color=False)) as frames:  # the next frames decoded while this one is tracked
         result = track_frames(tracker, frames, recording.num_frames, progress, overlap=overlap)

@@ -29,7 +29,6 @@ Every setting is a field of :class:`occupose.config.TrackerConfig`.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -87,20 +86,21 @@ class Tracker:
     config : a TrackerConfig, or the name of a method of :data:`occupose.config.METHODS`
         (default ``ours``)
     seed : int, seeds every person's filter (person n gets a generator spawned from it)
-    noise : None or camera name -> :class:`occupose.sensors.NoiseEstimate`, each camera's
-        measured depth noise (:func:`occupose.grid.noise.measure_noise` of the first
+    noise : None or camera name -> :class:`occupose.sensors.NoiseEstimate` (or the reason it
+        could not be measured), each camera's measured depth noise
+        (:func:`occupose.grid.noise.measure_noise` of the first
         ``grid.noise_frames`` frames; :func:`occupose.run.track_recording` and
         :func:`occupose.live.track_live` measure it before the first frame), used with
         ``grid.noise_model`` measured. Without it, the tracker measures it itself on its
         first ``grid.noise_frames`` frames, which it tracks meanwhile with each camera's
-        named noise model (as ``grid.noise_model`` none); it then replays them through a
+        named noise model (as ``grid.noise_model`` preset); it then replays them through a
         grid made with the measured noise, and goes on with that grid (and the people it
         has). ``noise`` (after construction): camera name ->
         :class:`occupose.grid.noise.CameraNoise`, what the grid assumes of each camera.
     """
 
     def __init__(self, cameras, fps: float, config: TrackerConfig | str = "ours", *, seed: int = 0,
-                 noise: Mapping[str, NoiseEstimate] | None = None):
+                 noise: Mapping[str, NoiseEstimate | str] | None = None):
         config = as_config(config)
         cameras = [cameras] if isinstance(cameras, Camera) else list(cameras)
         self.cameras = cameras
@@ -112,12 +112,8 @@ class Tracker:
         self.model_name = model_for(cameras, pose.steep_down_deg) if pose.model == "auto" else pose.model
         grid = config.grid
         #: the frames (camera name -> depth) the noise is being measured on, or None
-        self._noise_frames: list[dict[str, np.ndarray]] | None = None
-        if grid.noise_model == "measured" and noise is None:
-            self._noise_frames = []
-            self.noise = camera_noise(cameras, dataclasses.replace(grid, noise_model=None))
-        else:
-            self.noise = camera_noise(cameras, grid, noise)
+        self._noise_frames = [] if grid.noise_model == "measured" and noise is None else None
+        self.noise = camera_noise(cameras, grid, noise)  # measured, none given: named until measured
         self._make_grid()
         blobs = config.blobs
         self.blobs = BlobTracker(self.fps, blobs.max_gap_s, gate_m=blobs.gate_m, gate_growth=blobs.gate_growth,
@@ -165,7 +161,8 @@ class Tracker:
         if len(self._noise_frames) < self.config.grid.noise_frames:
             return
         frames, self._noise_frames = self._noise_frames, None
-        self.noise = camera_noise(self.cameras, self.config.grid, measure_noise(self.cameras, frames, self.config.grid))
+        self.noise = camera_noise(self.cameras, self.config.grid,
+                                  measure_noise(self.cameras, frames, self.config.grid, strict=False))
         self._make_grid()
         for index, frame in enumerate(frames):
             self.grid.update(frame)

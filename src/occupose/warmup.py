@@ -110,7 +110,7 @@ def warm_up(config: TrackerConfig | str, cameras: Sequence[Camera], *,
         from occupose.grid.noise import measure_noise
 
         first = (f.depth for f in frames(scenario, num_frames=min(config.grid.noise_frames, scenario.num_frames)))
-        noise = measure_noise(scenario.cameras, first, config.grid)
+        noise = measure_noise(scenario.cameras, first, config.grid, strict=False)
     tracker = Tracker(scenario.cameras, scenario.fps, config, seed=0, noise=noise)
     track_frames(tracker, frames(scenario, num_frames=count), count)
     marker.parent.mkdir(parents=True, exist_ok=True)
