@@ -45,9 +45,9 @@ def test_a_warm_up_runs_once_per_settings(tmp_path):
 
 
 def test_a_warm_up_with_measured_noise_measures_its_scenes_noise(tmp_path):
-    """The tracker refuses measured noise without a measurement: the warm-up measures its
-    own scene's, as a run measures its recording's (it failed every `occupose track` with
-    ``--set grid.noise_model=measured`` before)."""
+    """A warm-up with measured noise runs: its tracker measures the scene's noise on its
+    first grid.noise_frames frames itself (every `occupose track` with
+    ``--set grid.noise_model=measured`` failed in its warm-up before 94973bb)."""
     measured = method_config("ours").with_values({"grid.noise_model": "measured", "grid.noise_frames": 5})
     assert warm_up(measured, [FRONT], folder=tmp_path, load=True) is True
 

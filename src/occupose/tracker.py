@@ -168,7 +168,11 @@ class Tracker:
             self.grid.update(frame)
             self._seed_still(frame, index)
         for person in self.people.values():
-            person.area = (np.asarray(self.spec.origin[:2]), self.spec.high[:2])
+            person.area = self._area()
+
+    def _area(self) -> tuple[np.ndarray, np.ndarray]:
+        """(low (2,), high (2,)) world x, y metres: the grid's floor area (Person's ``area``)."""
+        return np.asarray(self.spec.origin[:2], float), self.spec.high[:2]
 
     def _check_views(self, depths: Mapping[str, np.ndarray]) -> None:
         """Each camera's first frame with measurements (:func:`occupose.bounds.check_first_view`)."""
@@ -275,7 +279,7 @@ class Tracker:
         rng = np.random.default_rng(self._seeds.spawn(1)[0])
         person = start_person(np.concatenate(self._pending.pop(tid)), pixels, depths, centroid, velocity,
                               self.cameras, self.model_name, self.config, self.fps, rng,
-                              area=(np.asarray(self.spec.origin[:2]), self.spec.high[:2]))
+                              area=self._area())
         person.blob = tid
         self.people[tid] = person
         return person

@@ -105,13 +105,7 @@ def warm_up(config: TrackerConfig | str, cameras: Sequence[Camera], *,
         report(f"compiling the tracker's kernels for this machine: once, about a minute (cached in {cache_folder()})")
     name, count = SCENES[model]
     scenario = build_scenario(name, use_mocap=False)
-    noise = None
-    if config.grid.noise_model == "measured":  # as track_recording: the scene's noise from its first frames
-        from occupose.grid.noise import measure_noise
-
-        first = (f.depth for f in frames(scenario, num_frames=min(config.grid.noise_frames, scenario.num_frames)))
-        noise = measure_noise(scenario.cameras, first, config.grid, strict=False)
-    tracker = Tracker(scenario.cameras, scenario.fps, config, seed=0, noise=noise)
+    tracker = Tracker(scenario.cameras, scenario.fps, config, seed=0)  # measured noise: it measures itself
     track_frames(tracker, frames(scenario, num_frames=count), count)
     marker.parent.mkdir(parents=True, exist_ok=True)
     marker.touch()
