@@ -45,7 +45,23 @@ def walk_bag(tmp_path_factory):
     return bag, scene, pose
 
 
-def test_a_synthetic_bag_plays_as_a_camera_and_its_person_is_tracked(walk_bag):
+def _pelvis_errors(lines, scene) -> list[float]:
+    """The tracked pelvis' distance from the truth in each line (metres), and at most one
+    person in each."""
+    truth = scene.people[0].joints
+    errors = []
+    for line in lines:
+        assert len(line["people"]) <= 1
+        for person in line["people"]:
+            assert len(person["joints"]) == len(person["visible"]) == 15
+            pelvis = np.array(person["joints"][JOINT_INDEX["pelvis"]])
+            errors.append(np.linalg.norm(pelvis - truth[line["device_frame"] - 1, JOINT_INDEX["pelvis"]]))
+    return errors
+
+
+def test_a_synthetic_bag_plays_as_a_camera_and_counts_what_it_drops(walk_bag):
+    """In real time the frames tracked depend on the machine's load: what is checked is that
+    they come in order from the first and that every one not tracked is counted."""
     bag, scene, pose = walk_bag
     out, said = io.StringIO(), []
     with RealSenseCamera(bag=bag) as source:
@@ -65,16 +81,20 @@ def test_a_synthetic_bag_plays_as_a_camera_and_its_person_is_tracked(walk_bag):
     assert said[-1] == summary.status() and f"{summary.dropped} dropped" in said[-1]
     assert [line["frame"] for line in lines] == list(range(len(lines)))
     assert all(line["latency_ms"] > 0 for line in lines)
-    truth = scene.people[0].joints
-    errors = []
-    for line in lines:
-        assert len(line["people"]) <= 1  # one person (a busy machine drops more frames, and may lose them)
-        for person in line["people"]:
-            assert len(person["joints"]) == len(person["visible"]) == 15
-            pelvis = np.array(person["joints"][JOINT_INDEX["pelvis"]])
-            errors.append(np.linalg.norm(pelvis - truth[line["device_frame"] - 1, JOINT_INDEX["pelvis"]]))
-    assert len(errors) >= 0.5 * len(lines)  # tracked in most frames
-    assert np.median(errors) < 0.10, errors  # metres
+    _pelvis_errors(lines, scene)  # one person at most, however many frames were dropped
+
+
+def test_a_bag_played_frame_by_frame_tracks_every_frame_and_its_person(walk_bag):
+    bag, scene, pose = walk_bag
+    out = io.StringIO()
+    with RealSenseCamera(bag=bag, real_time=False) as source:
+        summary = track_live(source, "ours", out=out, pose=pose)
+    lines = [json.loads(line) for line in out.getvalue().splitlines()]
+    assert [line["device_frame"] for line in lines] == list(range(1, FRAMES + 1))
+    assert summary.dropped == 0 and all(line["dropped"] == 0 for line in lines)
+    errors = _pelvis_errors(lines, scene)
+    assert len(errors) >= 0.8 * FRAMES  # tracked from its first frames
+    assert np.median(errors) < 0.06, errors  # metres (2.9 cm when written, the same on a busy machine)
 
 
 def test_live_with_measured_noise_measures_it_on_the_first_frames(walk_bag):
@@ -125,6 +145,12 @@ def test_live_on_the_command_line_writes_json_lines_and_refuses_to_overwrite(wal
     assert floor.exit_code == 0, floor.output  # no pose given: the floor of the first frames places it
     tracked = len((tmp_path / "floor.jsonl").read_text().splitlines())  # 5, or fewer where the bag ends first
     assert "placed from the floor" in floor.output and 1 <= tracked <= 5 and f"{tracked} frames tracked" in floor.output
+    every = tmp_path / "every.jsonl"
+    played = CliRunner().invoke(main, [*args[:5], str(every), *args[6:], "--every-frame"])
+    assert played.exit_code == 0, played.output
+    assert [json.loads(line)["device_frame"] for line in every.read_text().splitlines()] == [1, 2, 3, 4, 5]
+    camera = CliRunner().invoke(main, ["live", "--realsense", "--every-frame", "--out", str(tmp_path / "c.jsonl")])
+    assert camera.exit_code != 0 and "--every-frame plays a --bag" in camera.output
 
 
 @pytest.mark.shared

@@ -567,6 +567,8 @@ def batch_cmd(inputs, out, jobs, scheduler, method, model, filter_name, likeliho
 @click.option("--device", "serial", default=None, metavar="SERIAL", help="The camera's serial number (default: the first).")
 @click.option("--bag", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="Play a RealSense .bag in real time as if it were the camera.")
+@click.option("--every-frame", is_flag=True,
+              help="With --bag: play every frame at the tracker's pace instead of in real time (none dropped).")
 @click.option("--out", type=click.Path(dir_okay=False, allow_dash=True, path_type=Path), default=Path("-"),
               show_default=True, help="File of the JSON lines, one per tracked frame (-: standard output).")
 @click.option("--frames", "max_frames", type=click.IntRange(min=1), default=None,
@@ -579,8 +581,8 @@ def batch_cmd(inputs, out, jobs, scheduler, method, model, filter_name, likeliho
               default=None, help="A JSON file of the camera's pose (docs/inputs.md).")
 @_settings_options
 @click.option("--force", is_flag=True, help="Replace a JSON lines file occupose wrote at --out.")
-def live_cmd(realsense, serial, bag, out, max_frames, camera_height, tilt, pose_file, method, model, filter_name,
-             likelihood, particles, layers, seed, config_file, assignments, force) -> None:
+def live_cmd(realsense, serial, bag, every_frame, out, max_frames, camera_height, tilt, pose_file, method, model,
+             filter_name, likelihood, particles, layers, seed, config_file, assignments, force) -> None:
     """Track people as a RealSense camera delivers its frames, the newest each time: frames
     the tracking has no time for are dropped and counted. One JSON line per tracked frame
     (docs/outputs.md) to --out; a status line (frames, drops, latency) on stderr every second."""
@@ -589,7 +591,10 @@ def live_cmd(realsense, serial, bag, out, max_frames, camera_height, tilt, pose_
     config, _ = _config_of(method, model, filter_name, likelihood, particles, layers, config_file, assignments)
     pose = _source_kwargs(camera_height=camera_height, tilt=tilt, pose_file=pose_file)["pose"]
     try:
-        with RealSenseCamera(serial=serial, bag=bag) as camera, _json_lines(out, force) as stream:
+        if every_frame and bag is None:
+            raise ValueError("--every-frame plays a --bag: a camera's frames come in real time")
+        with RealSenseCamera(serial=serial, bag=bag, real_time=not every_frame) as camera, \
+                _json_lines(out, force) as stream:
             summary = track_live(camera, config, out=stream, pose=pose, seed=seed, max_frames=max_frames,
                                  status=lambda line: click.echo(line, err=True))
     except (ValueError, FileNotFoundError, ImportError) as error:

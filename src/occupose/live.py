@@ -3,7 +3,8 @@
 :class:`RealSenseCamera` opens an Intel RealSense depth camera with ``pyrealsense2`` (the
 ``realsense`` extra), or plays a RealSense ``.bag`` through its playback device in real
 time, which is how it is tested: frames come at the recorded rate whether or not they are
-taken. :func:`track_live` tracks them one after another, always the newest. When the
+taken. A bag can also be played at the tracker's pace (``real_time=False``, ``--every-frame``):
+every frame, none dropped, so what is tracked does not depend on the machine's load. :func:`track_live` tracks them one after another, always the newest. When the
 tracking falls behind, the frames it had no time for are dropped, counted from the gaps
 in the device's frame numbers and reported. Every tracked frame gives one JSON line
 (:func:`frame_record`), flushed at once, and a status line on stderr about every second
@@ -59,15 +60,18 @@ class LiveFrame:
 
 class RealSenseCamera:
     """A RealSense depth stream: a camera (``serial``, or the first connected) or a ``bag``
-    played in real time. ``camera`` : its intrinsics as a :class:`Camera` (no world pose
+    played in real time, or with ``real_time=False`` every frame of it, each when the one
+    before has been taken. ``camera`` : its intrinsics as a :class:`Camera` (no world pose
     yet), ``fps`` : its frame rate. Use as a context manager, or :meth:`close`."""
 
-    def __init__(self, *, serial: str | None = None, bag: str | Path | None = None):
+    def __init__(self, *, serial: str | None = None, bag: str | Path | None = None, real_time: bool = True):
         from occupose.io.sources import require
 
         rs = require("pyrealsense2", "realsense", "a live RealSense camera")
         if serial is not None and bag is not None:
             raise ValueError("give a camera's serial number or a bag, not both")
+        if not real_time and bag is None:
+            raise ValueError("a live camera plays in real time: only a bag can be played frame by frame")
         config = rs.config()
         if bag is not None:
             if not Path(bag).is_file():
@@ -78,19 +82,22 @@ class RealSenseCamera:
         config.enable_stream(rs.stream.depth)
         self._rs = rs
         self._pipeline = rs.pipeline()
-        # Every frame delivered goes to a queue of ours: the pipeline's own holds only the newest, so a
-        # bag's first frames, played before it could be paused, would be lost on a busy machine.
-        self._queue = rs.frame_queue(QUEUE_FRAMES, keep_frames=True)
+        # In real time every frame delivered goes to a queue of ours: the pipeline's own holds only the
+        # newest, so a bag's first frames, played before it could be paused, would be lost on a busy
+        # machine. Played frame by frame the pipeline's own is the one that waits for each frame to be
+        # taken (a playback into a queue of ours stops after two frames).
+        self._queue = rs.frame_queue(QUEUE_FRAMES, keep_frames=True) if real_time else None
         try:
-            profile = self._pipeline.start(config, self._queue)
+            profile = self._pipeline.start(config, self._queue) if real_time else self._pipeline.start(config)
         except RuntimeError as error:
             what = f"{bag}: not a RealSense recording it can play" if bag is not None else "no RealSense camera"
             raise ValueError(f"{what} ({error})") from None
         device = profile.get_device()
         self._playback = device.as_playback() if bag is not None else None
         if self._playback is not None:
-            self._playback.set_real_time(True)
-            self._playback.pause()  # until the first frame is asked for (frames)
+            self._playback.set_real_time(real_time)
+            if real_time:
+                self._playback.pause()  # until the first frame is asked for (frames)
         stream = profile.get_stream(rs.stream.depth).as_video_stream_profile()
         k = stream.get_intrinsics()
         self.fps = float(stream.fps())
@@ -104,10 +111,13 @@ class RealSenseCamera:
         :data:`FRAME_TIMEOUT_MS` (a bag played to its end, a camera unplugged)."""
         self.resume()
         while True:
-            ok, frame = self._queue.try_wait_for_frame(FRAME_TIMEOUT_MS)
+            if self._queue is None:  # frame by frame
+                ok, frame = self._pipeline.try_wait_for_frames(FRAME_TIMEOUT_MS)
+            else:
+                ok, frame = self._queue.try_wait_for_frame(FRAME_TIMEOUT_MS)
             if not ok:
                 return
-            while self._last is not None or self._playback is None:  # those that came meanwhile: the newest
+            while self._queue is not None and (self._last is not None or self._playback is None):  # the newest
                 newer = self._queue.poll_for_frame()
                 if not newer:
                     break
@@ -120,13 +130,14 @@ class RealSenseCamera:
             yield LiveFrame(number, float(depth.get_timestamp()), metres, dropped, time.perf_counter())
 
     def pause(self) -> None:
-        """Hold a played bag where it is (a live camera cannot be held: its frames go on,
-        and those not taken count as dropped)."""
-        if self._playback is not None:
+        """Hold a bag played in real time where it is (a live camera cannot be held: its
+        frames go on, and those not taken count as dropped; a bag played frame by frame
+        waits anyway)."""
+        if self._playback is not None and self._queue is not None:
             self._playback.pause()
 
     def resume(self) -> None:
-        if self._playback is not None:
+        if self._playback is not None and self._queue is not None:
             self._playback.resume()
 
     def close(self) -> None:
