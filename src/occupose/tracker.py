@@ -89,8 +89,8 @@ class Tracker:
     noise : None or camera name -> :class:`occupose.sensors.NoiseEstimate` (or the reason it
         could not be measured), each camera's measured depth noise
         (:func:`occupose.grid.noise.measure_noise` of the first
-        ``grid.noise_frames`` frames; :func:`occupose.run.track_recording` and
-        :func:`occupose.live.track_live` measure it before the first frame), used with
+        ``grid.noise_frames`` frames; :func:`occupose.run.track_recording` measures it
+        before the first frame), used with
         ``grid.noise_model`` measured. Without it, the tracker measures it itself on its
         first ``grid.noise_frames`` frames, which it tracks meanwhile with each camera's
         named noise model (as ``grid.noise_model`` preset); it then replays them through a
@@ -111,7 +111,8 @@ class Tracker:
         pose = config.pose
         self.model_name = model_for(cameras, pose.steep_down_deg) if pose.model == "auto" else pose.model
         grid = config.grid
-        #: the frames (camera name -> depth) the noise is being measured on, or None
+        #: the frames the noise is being measured on, or None: (camera name -> depth, the
+        #: capsules its grid update held, :meth:`_hold_capsules`)
         self._noise_frames = [] if grid.noise_model == "measured" and noise is None else None
         self.noise = camera_noise(cameras, grid, noise)  # measured, none given: named until measured
         self._make_grid()
@@ -150,22 +151,24 @@ class Tracker:
             self.grid.seed_moving(still_people(self.grid.states, self.spec, depths, self.cameras, self.config.start,
                                                self.config.size, self.config.blobs.join_m) & ~self.grid.moving_mask())
 
-    def _measure_noise(self, depths: Mapping[str, np.ndarray]) -> None:
-        """Keep this frame for the noise measurement (a Tracker given no ``noise`` with
-        ``grid.noise_model`` measured); with ``grid.noise_frames`` of them, measure, make the
-        grid again with the measured noise and replay them through it (no hold: the
-        people's bodies of those frames are gone)."""
+    def _measure_noise(self, depths: Mapping[str, np.ndarray], held) -> None:
+        """Keep this frame, and the capsules ``held`` in its grid update, for the noise
+        measurement (a Tracker given no ``noise`` with ``grid.noise_model`` measured); with
+        ``grid.noise_frames`` of them, measure, make the grid again with the measured noise
+        and replay them through it, each with its hold (without it, a person still from
+        the first frame would fade into the background that much sooner)."""
         from occupose.grid.noise import measure_noise
 
-        self._noise_frames.append({name: np.array(d, np.float32) for name, d in depths.items()})
+        self._noise_frames.append(({name: np.array(d, np.float32) for name, d in depths.items()}, held))
         if len(self._noise_frames) < self.config.grid.noise_frames:
             return
-        frames, self._noise_frames = self._noise_frames, None
+        kept, self._noise_frames = self._noise_frames, None
+        frames = [frame for frame, _ in kept]
         self.noise = camera_noise(self.cameras, self.config.grid,
                                   measure_noise(self.cameras, frames, self.config.grid, strict=False))
         self._make_grid()
-        for index, frame in enumerate(frames):
-            self.grid.update(frame)
+        for index, (frame, held) in enumerate(kept):
+            self.grid.update(frame, hold=self._hold_cells(held))
             self._seed_still(frame, index)
         for person in self.people.values():
             person.area = self._area()
@@ -204,14 +207,16 @@ class Tracker:
         seconds = dict.fromkeys(STAGES, 0.0)
         clock = time.perf_counter()
         self._check_views(depths)
+        held = None  # the capsules this frame's grid update holds, when it runs here
         if self._grid_job is not None:  # this frame's grid update ran during the last stage 3
             self._grid_job.result()
             self._grid_job = None
         else:
-            self.grid.update(depths, hold=self._hold())
+            held = self._hold_capsules()
+            self.grid.update(depths, hold=self._hold_cells(held))
         self._seed_still(depths, self.frame)
-        if self._noise_frames is not None:
-            self._measure_noise(depths)
+        if self._noise_frames is not None:  # (no grid job meanwhile: held is this frame's)
+            self._measure_noise(depths, held)
         clock = _tick(seconds, "grid", clock)
         blobs = self.config.blobs
         labels, found = blobs_from_mask(self.grid.moving_mask(), self.spec, min_cells=blobs.min_cells,
@@ -236,7 +241,7 @@ class Tracker:
         if upcoming is not None and self._noise_frames is None:  # (the grid may be made again while measuring)
             if self._pool is None:
                 self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="occupose-grid")
-            self._grid_job = self._pool.submit(self.grid.update, upcoming, self._hold())
+            self._grid_job = self._pool.submit(self.grid.update, upcoming, self._hold_cells(self._hold_capsules()))
         clock = _tick(seconds, "observations", clock)
         out = {}
         for tid in seen:
@@ -302,10 +307,10 @@ class Tracker:
             if gap < self.config.carry.rejoin_m:
                 lost.pop(pid).blob = tid
 
-    def _hold(self) -> np.ndarray | None:
-        """(nx, ny, nz) bool, the cells within ``grid.hold_margin`` of the bodies of the
-        people estimated in the last frame, or None when there are none (or with
-        ``grid.hold_people`` off)."""
+    def _hold_capsules(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The capsules (ends a, b (K, 3) world metres, radii (K,) metres) of the bodies of
+        the people estimated in the last frame, which the grid holds, or None when there
+        are none (or with ``grid.hold_people`` off)."""
         if not self.config.grid.hold_people:
             return None
         bodies = [capsules_from_poses(p.model, p.pose[None]) + (p.model.capsule_radii,)
@@ -313,7 +318,12 @@ class Tracker:
         if not bodies:
             return None
         a, b, radii = (np.concatenate([body[i][0] if i < 2 else body[i] for body in bodies]) for i in range(3))
-        return cells_near_capsules(self.spec, a, b, radii, self.config.grid.hold_margin)
+        return a, b, radii
+
+    def _hold_cells(self, capsules) -> np.ndarray | None:
+        """(nx, ny, nz) bool, the cells within ``grid.hold_margin`` of ``capsules``
+        (:meth:`_hold_capsules`), or None for None."""
+        return None if capsules is None else cells_near_capsules(self.spec, *capsules, self.config.grid.hold_margin)
 
 
 def _tick(seconds: dict[str, float], stage: str, start: float) -> float:
