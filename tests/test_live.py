@@ -97,17 +97,21 @@ def test_a_bag_played_frame_by_frame_tracks_every_frame_and_its_person(walk_bag)
     assert np.median(errors) < 0.06, errors  # metres (2.9 cm when written, the same on a busy machine)
 
 
-def test_live_with_measured_noise_measures_it_on_the_first_frames(walk_bag):
-    """grid.noise_model measured: the camera's noise is measured on its next frames (after
-    the pose), which are not tracked, and the tracker takes it (it refuses to run without)."""
-    bag, scene, pose = walk_bag
+def test_live_measures_the_noise_on_the_first_frames_it_tracks(walk_bag):
+    """grid.noise_model measured (the default): the tracker measures the camera's noise on
+    its first grid.noise_frames frames, which it tracks meanwhile with the preset's model."""
+    bag, _, pose = walk_bag
     out, said = io.StringIO(), []
-    measured = method_config("ours").with_values({"grid.noise_model": "measured", "grid.noise_frames": 5})
-    with RealSenseCamera(bag=bag) as source:
-        summary = track_live(source, measured, out=out, pose=pose, status=said.append)
+    with RealSenseCamera(bag=bag, real_time=False) as source:
+        summary = track_live(source, method_config("ours").with_values({"grid.noise_frames": 5}), out=out,
+                             pose=pose, status=said.append)
     lines = [json.loads(line) for line in out.getvalue().splitlines()]
-    assert "measuring the camera's depth noise over its next 5 frames" in said
-    assert summary.frames == len(lines) > 0 and lines[0]["device_frame"] > 5  # the first five were measured
+    assert said[0] == "the camera's depth noise is measured on its first 5 frames tracked"
+    assert [line["device_frame"] for line in lines[:5]] == [1, 2, 3, 4, 5]  # tracked, not set aside
+    assert summary.noise["model"] == "measured" and summary.noise["frames"] == 5
+    with RealSenseCamera(bag=bag, real_time=False) as source:  # a run shorter than the measurement
+        short = track_live(source, "ours", out=io.StringIO(), pose=pose, max_frames=3)
+    assert short.noise["model"] == "structured_light" and short.noise["unmeasured"] == "not measured"
 
 
 def test_a_tracker_slower_than_the_camera_drops_frames_and_says_so(walk_bag):

@@ -20,7 +20,6 @@ used only for that.
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 import time
@@ -167,13 +166,15 @@ def frame_record(index: int, frame: LiveFrame, estimates, latency_ms: float, dro
 @dataclass
 class LiveSummary:
     """What a live run did: frames tracked, frames dropped (including those taken for the
-    floor), latencies (ms, one per tracked frame), the track ids seen, the pose used."""
+    floor), latencies (ms, one per tracked frame), the track ids seen, the pose used, the
+    noise the grid assumed at the end (:meth:`occupose.grid.noise.CameraNoise.to_dict`)."""
 
     frames: int = 0
     dropped: int = 0
     latencies: list[float] = field(default_factory=list)
     tracks: set[int] = field(default_factory=set)
     pose: str = ""
+    noise: dict = field(default_factory=dict)
 
     def latency(self, q: float) -> float:
         """The ``q`` quantile (0-1) of the latencies, ms (NaN before any frame)."""
@@ -221,17 +222,11 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
     config = as_config(config)
     frames = source.frames()
     camera, origin = _place(source.camera, frames, pose, config)
-    noise = None
-    if config.grid.noise_model == "measured":  # as track_recording: from the camera's next frames
-        from occupose.grid.noise import measure_noise
-
-        if status is not None:
-            status(f"measuring the camera's depth noise over its next {config.grid.noise_frames} frames")
-        first = itertools.islice(frames, config.grid.noise_frames)
-        noise = measure_noise([camera], ({camera.name: frame.depth} for frame in first), config.grid, strict=False)
+    if config.grid.noise_model == "measured" and status is not None:  # the tracker measures it (Tracker)
+        status(f"the camera's depth noise is measured on its first {config.grid.noise_frames} frames tracked")
     source.pause()  # a played bag waits for the warm-up; a camera's frames meanwhile are dropped
     warmup.warm_up(config, [camera], report=status, load=True)
-    tracker = Tracker([camera], source.fps, config, seed=seed, noise=noise)
+    tracker = Tracker([camera], source.fps, config, seed=seed)
     source.resume()
     summary = LiveSummary(pose=origin)
     offset = math.inf  # host clock minus device clock (s), least over the frames: the least delayed one's
@@ -251,6 +246,7 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
         if status is not None and time.perf_counter() - last_status >= STATUS_EVERY_S:
             status(summary.status())
             last_status = time.perf_counter()
+    summary.noise = tracker.noise[camera.name].to_dict()
     if status is not None:
         status(summary.status())
     return summary

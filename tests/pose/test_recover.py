@@ -55,15 +55,18 @@ def test_the_test_fires_on_a_lost_estimate_and_not_on_a_good_one(walk):
 @pytest.mark.parametrize("throw", [0.6, -0.4])
 def test_an_estimate_thrown_off_its_person_comes_back_sooner(walk, throw):
     """With the searches on (every 15 frames, and at once after doubtful ones; off by
-    default) the estimate thrown 0.6 m or 0.4 m off is back within 9 cm 4 frames later and
-    stays there (measured at most 8 cm), the same id, no other track; without the searches
-    it comes back by itself more slowly (measured: a mean of 13 and 14 cm over the 10
-    frames from then on)."""
+    default) the estimate thrown 0.6 m or 0.4 m off is back 4 frames later and stays there
+    (measured with the measured noise model: medians of 5.5 and 6.6 cm from then on, at
+    most 7.5 and 9.5 cm), the same id, no other track; without the searches it comes back
+    by itself more slowly (measured: a mean of 14.6 and 14.2 cm over the 10 frames from
+    then on, against 5.4 and 7.4 cm with them). Not on every seed: with seed 1 the one
+    thrown 0.4 m is found worse by the search (19.9 cm) than by itself (5.6 cm)."""
     tracker, errors = _run(walk, {"recover.enabled": True}, throw)
     assert tracker.people[1].recoveries >= 1 and list(tracker.people) == [1]
-    assert max(errors[4:]) < 0.09, np.round(errors, 3)
+    assert np.median(errors[4:]) < 0.07 and max(errors[4:]) < 0.12, np.round(errors, 3)
     _, without = _run(walk, {"recover.enabled": False}, throw)
-    assert np.mean(without[4:14]) > 0.10, np.round(without, 3)
+    assert np.mean(without[4:14]) > 0.10 and np.mean(errors[4:14]) < np.mean(without[4:14]) - 0.05, \
+        np.round(without, 3)
 
 
 def test_searching_on_schedule_keeps_a_good_estimate(walk):
