@@ -191,3 +191,27 @@ def test_a_tracker_given_no_measurement_measures_the_noise_on_its_first_frames()
     assert not itself.people and not given.people
     for frame in depths[4:]:
         itself.update(frame)
+
+
+def test_a_big_surface_outweighs_small_bins_and_the_fit_does_not_fall_with_depth():
+    """random-6's first frames, as pixel series: a ceiling camera sees the floor at 2.15-2.65 m
+    (135 000 pixels, the nominal structured-light noise), a couch's seat at 1.78 m (20 000
+    pixels, 2.1 mm: the seat parallel to the image lies between the disparity steps) and the
+    top of a still person's head at 0.74-0.8 m (3 000 pixels, 2.2 mm). Fitted with every bin
+    weighing the same, the quadratic through them fell to 0.6 mm at 1.2 m, where the person's
+    shoulders are (its run went from 13 to 26-42 cm); weighed by their pixels the small bins
+    are off the floor's fit and dropped, and what is left does not fall with depth."""
+    rng = np.random.default_rng(0)
+    parts = [(np.linspace(2.15, 2.65, 135_000), None), (np.full(20_000, 1.78), 0.0021),
+             (np.linspace(0.74, 0.80, 3_000), 0.0022)]
+    series = []
+    for depth, std in parts:
+        scale = depth_std(depth, "structured_light") if std is None else np.full(depth.size, std)
+        series.append(depth[:, None] + scale[:, None] * rng.standard_normal((depth.size, NUM_FRAMES)))
+    pixels = np.concatenate(series)  # (N, T) metres
+    depths = pixels.T.reshape(NUM_FRAMES, 1, -1).astype(np.float32)
+    estimate = estimate_depth_noise(depths)
+    assert estimate.bin_depths.min() > 2.0, estimate.bin_depths  # the couch's and the head's bins left out
+    z = np.linspace(0.8, 2.6, 10)
+    assert np.all(np.diff(estimate.std(z)) >= 0)
+    np.testing.assert_allclose(estimate.std(z), depth_std(z, "structured_light"), rtol=0.35)

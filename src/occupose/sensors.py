@@ -147,10 +147,14 @@ def estimate_depth_noise(depths, *, bin_width: float = GridConfig.noise_bin,
     bins remain, the bin farthest off the fit of the bins, if more than 1.5 times off (either
     way), is dropped and the rest refitted.
 
-    The bins' stds are fitted (least squares of the relative error) with c0 + c1 z + c2 z^2
-    when there are at least 4 bins and that fit has c2 >= 0 and stays positive for
-    z >= 0; else with c0 + c2 z^2 (c0, c2 >= 0), which grows with depth as both named
-    models do far away; one bin gives c2 z^2 through it. Returns a NoiseEstimate.
+    The bins' stds are fitted (least squares of the relative error, each bin weighed by
+    the square root of its pixels: a floor's 100 000 outweigh a still head's 3 000) with
+    c0 + c1 z + c2 z^2 when there are at least 4 bins and that fit has c2 >= 0, stays
+    positive for z >= 0 and does not fall beyond the nearest bin (no sensor is less noisy
+    farther away there; a free quadratic through a few small, low bins dipped to a quarter
+    of the floor's noise in between); else with c0 + c2 z^2 (c0, c2 >= 0), which grows with
+    depth as both named models do far away; one bin gives c2 z^2 through it. Returns a
+    NoiseEstimate.
     Raises ValueError for a bad array, fewer than MIN_NOISE_FRAMES frames, or no bin
     with ``min_pixels`` static pixels.
     """
@@ -193,28 +197,30 @@ def estimate_depth_noise(depths, *, bin_width: float = GridConfig.noise_bin,
                          f"{min_pixels} static pixels measured in all {num_frames} frames; the frames have "
                          f"{series.shape[0]} such pixels in all")
     z, s, n = np.array(depths_b), np.array(stds_b), np.array(pixels_b, np.int64)
-    coefficients = _fit(z, s)
+    coefficients = _fit(z, s, n)
     while z.size >= 3:  # drop the bin farthest off the others' fit while it is off by more than _BIN_OUTLIER
         ratio = np.abs(np.log(np.maximum(s, 1e-9) / np.maximum(std_from_coefficients(z, coefficients), 1e-9)))
         worst = int(np.argmax(ratio))
         if ratio[worst] <= math.log(_BIN_OUTLIER):
             break
         z, s, n = (np.delete(a, worst) for a in (z, s, n))
-        coefficients = _fit(z, s)
+        coefficients = _fit(z, s, n)
     return NoiseEstimate(coefficients, int(n.sum()), num_frames, (float(z.min()), float(z.max())), z, s, n, far)
 
 
-def _fit(z: np.ndarray, s: np.ndarray) -> np.ndarray:
+def _fit(z: np.ndarray, s: np.ndarray, n: np.ndarray) -> np.ndarray:
     """(3,) c0, c1, c2 of the std form fitted to the bins' stds ``s`` at depths ``z`` ((B,) metres),
     as :func:`estimate_depth_noise` describes."""
     if not np.any(s > 0):
         return np.zeros(3)
-    weight = 1.0 / np.maximum(s, s[s > 0].min())  # relative error: the stds span an order of magnitude
+    # relative error (the stds span an order of magnitude), a bin weighing by the square root
+    # of its pixels (its std is that much surer)
+    weight = np.sqrt(n / n.sum()) / np.maximum(s, s[s > 0].min())
     if z.size >= _FULL_FIT_BINS:
         full = np.linalg.lstsq(np.column_stack([np.ones_like(z), z, z**2]) * weight[:, None], s * weight,
                                rcond=None)[0]
         c0, c1, c2 = full
-        if c2 >= 0 and _lowest(full) > 0:
+        if c2 >= 0 and _lowest(full) > 0 and c1 + 2 * c2 * z.min() >= 0:  # not falling beyond the nearest bin
             return full
     if z.size >= 2:
         c0, c2 = np.linalg.lstsq(np.column_stack([np.ones_like(z), z**2]) * weight[:, None], s * weight,
