@@ -3,9 +3,10 @@
 :class:`RealSenseCamera` opens an Intel RealSense depth camera with ``pyrealsense2`` (the
 ``realsense`` extra), or plays a RealSense ``.bag`` through its playback device in real
 time, which is how it is tested: frames come at the recorded rate whether or not they are
-taken. A bag can also be played at the tracker's pace (``real_time=False``, ``--every-frame``):
-every frame, none dropped, so what is tracked does not depend on the machine's load. :func:`track_live` tracks them one after another, always the newest. When the
-tracking falls behind, the frames it had no time for are dropped, counted from the gaps
+taken. A bag can also be played at the tracker's pace (``real_time=False``,
+``--every-frame``): every frame, none dropped, so what is tracked does not depend on the
+machine's load. :func:`track_live` tracks them one after another, always the newest. When
+the tracking falls behind, the frames it had no time for are dropped, counted from the gaps
 in the device's frame numbers and reported. Every tracked frame gives one JSON line
 (:func:`frame_record`), flushed at once, and a status line on stderr about every second
 says the frames, drops, latency and people.
