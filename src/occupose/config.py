@@ -157,11 +157,12 @@ class GridConfig(_Section):
                                             "the camera's sensor preset's far range (for a camera that matches "
                                             "no preset: the farthest depth it measured with grid.noise_model "
                                             "measured, else 4.5 m)", "m", above=0.0)
-    noise_model: str | None = setting("measured", "depth noise model of every camera; none (or preset): the camera's "
-                                            "sensor preset's (structured_light for a camera that matches no "
-                                            "preset); measured: each camera's own, from the temporal spread of its "
-                                            "static pixels in the first grid.noise_frames frames (the preset's "
-                                            "where they allow no estimate, and until they are measured)",
+    noise_model: str | None = setting("measured", "depth noise model of every camera; none (or preset): the "
+                                                  "camera's sensor preset's (structured_light for a camera that "
+                                                  "matches no preset); measured: each camera's own, from the "
+                                                  "temporal spread of its static pixels in the first "
+                                                  "grid.noise_frames frames (the preset's where they allow no "
+                                                  "estimate, and until they are measured)",
                                       choices=NOISE_MODEL_NAMES + ("measured", "preset"))
     noise_frames: int = setting(30, "grid.noise_model measured: frames at the start of a recording whose static "
                                     "pixels give each camera's depth noise", "frames", low=3, high=1000)

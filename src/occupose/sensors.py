@@ -210,7 +210,7 @@ def estimate_depth_noise(depths, *, bin_width: float = GridConfig.noise_bin,
 
 def _fit(z: np.ndarray, s: np.ndarray, n: np.ndarray) -> np.ndarray:
     """(3,) c0, c1, c2 of the std form fitted to the bins' stds ``s`` at depths ``z`` ((B,) metres),
-    as :func:`estimate_depth_noise` describes."""
+    of ``n`` (B,) static pixels each, as :func:`estimate_depth_noise` describes."""
     if not np.any(s > 0):
         return np.zeros(3)
     # relative error (the stds span an order of magnitude), a bin weighing by the square root
