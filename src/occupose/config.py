@@ -332,6 +332,16 @@ class CarryConfig(_Section):
     twin_share: float = setting(0.8, "the estimate turns to its twin when the twin explains the points better "
                                      "in at least this share of the window's comparisons", "share",
                                 low=0.5, high=1)
+    start_twin_s: float = setting(1.5, "over a new person's first this many seconds, until it walks faster than "
+                                       "walking_speed, its estimate is compared with its twin (whatever twin says) "
+                                       "to settle the way it faces; 0: never",
+                                  "s", low=0)
+    start_twin_count: int = setting(5, "the way a new person faces is settled on these comparisons (one every "
+                                       "twin_every estimates) when there are at least this many",
+                                    "comparisons", low=2)
+    start_twin_t: float = setting(2.0, "... by the t statistic of the twin's gains in log-likelihood over the "
+                                       "estimate: the twin is taken at this or more, the estimate kept at minus "
+                                       "this or less; in between nothing is settled", "", above=0)
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,7 @@ import pytest
 from occupose.body import body_model, standing_pose
 from occupose.camera import camera_preset, look_at
 from occupose.config import CarryConfig, TrackerConfig
+from occupose.likelihood import View, observation_from_views
 from occupose.pose.person import Person
 
 CARRY = CarryConfig()
@@ -71,6 +72,74 @@ def test_a_person_walking_backwards_is_turned_round_at_the_start_or_when_walking
     person.face_the_way_walked()
     heading = person.pose[model.dof_names.index("heading")]
     assert abs(abs(heading) - np.pi) < 1e-9 if turned else heading == 0.0
+
+
+@pytest.mark.parametrize("gains, turned, settled", [
+    ([0.05, 0.02, 0.08, -0.01, 0.06, 0.04], True, True),  # t = 3.1
+    ([-0.05, -0.02, -0.08, 0.01, -0.06, -0.04], False, True),  # t = -3.1: the estimate is kept
+    ([0.1, -0.1, 0.2, -0.05, 0.03], False, False),  # t = 0.67: nothing is settled
+    ([0.05, 0.02, 0.08, 0.04], False, False),  # t = 3.8, but too few comparisons
+])
+def test_the_start_settles_the_way_a_person_faces_on_its_twins_gains(gains, turned, settled):
+    """At the end of a new person's first CARRY.start_twin_s seconds (Person.settle_facing), the
+    twin's gains in log-likelihood over the estimate (nats), when there are at least
+    CARRY.start_twin_count of them, decide by their t statistic: the twin is taken at
+    CARRY.start_twin_t or more, the estimate kept at minus that or less; either heading is
+    then settled."""
+    assert CARRY.start_twin_count == 5 and CARRY.start_twin_t == 2.0
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.3)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.start_twins = pose, list(gains)
+    person.estimates = int(CARRY.start_twin_s * 30) + 1
+    _walk(person, [np.zeros(2)] * CARRY.frames)  # standing still
+    person.settle_facing()
+    heading = person.pose[model.dof_names.index("heading")]
+    assert person.start_twins is None  # decided once
+    assert abs(abs((heading - 0.3 + np.pi) % (2 * np.pi) - np.pi) - (np.pi if turned else 0.0)) < 0.05
+    assert person.settled == (heading if settled else None)
+
+
+@pytest.mark.parametrize("speed, decided", [(0.0, False), (0.2, False), (0.6, True)])
+def test_the_start_compares_a_person_with_its_twin_until_it_walks(speed, decided):
+    """Within its first CARRY.start_twin_s seconds a person standing or swaying is compared
+    with its twin again (one more gain every CARRY.twin_every estimates); one walking faster
+    than CARRY.walking_speed is decided on the gains so far (walking says nothing about one
+    who walks backwards, and a walk's gains are the walking prior's)."""
+    assert CARRY.walking_speed == 0.3 and CARRY.twin_every == 3
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.start_twins, person.estimates = pose, [0.05, 0.02, 0.08, -0.01, 0.06, 0.04], 21
+    depth = np.zeros((FRONT.height, FRONT.width), np.float32)
+    depth[100:400, 280:360] = 3.0  # a person-sized patch of points where it stands
+    person.problem.set_observation(observation_from_views([View(FRONT, depth, depth > 0)]))
+    _walk(person, [np.array([speed / 30.0 * i, 0.0]) for i in range(CARRY.frames)])
+    person.settle_facing()
+    assert (person.start_twins is None) == decided
+    if not decided:
+        assert len(person.start_twins) == 7  # one more: its twin's gain now
+
+
+@pytest.mark.parametrize("settled, kept", [(0.0, True), (0.3, True), (np.pi, False), (None, False)])
+def test_a_heading_settled_by_the_limbs_is_kept_against_a_walk_backwards(settled, kept):
+    """The estimate faces +x and the path goes along -x at 1.2 m/s. A heading settled by the
+    start's twin test (Person.settle_facing) within a quarter turn of the estimate's is kept:
+    no turn round and no walking prior (it walks backwards); one a half turn off is dropped
+    (the person has turned since), and then, as with none, the walk turns the estimate."""
+    model = body_model("full")
+    person = _person(model)
+    pose = standing_pose(model, (0.0, 0.0), 0.0)
+    person.estimator.initialise(pose, 0.0)
+    person.pose, person.estimates, person.since_turn, person.settled = pose, 100, CARRY.frames, settled
+    _walk(person, [np.array([-1.2 / 30.0 * i, 0.0]) for i in range(CARRY.frames)])
+    assert (person.walking() is None) == kept
+    person.face_the_way_walked()
+    heading = person.pose[model.dof_names.index("heading")]
+    assert heading == 0.0 if kept else abs(abs(heading) - np.pi) < 1e-9
+    assert (person.settled is not None) == kept
 
 
 @pytest.mark.parametrize("lowest, moves", [(0.95, True), (0.86, True), (0.84, False), (0.65, False)])
@@ -217,26 +286,31 @@ def standing_still():
 
 @pytest.mark.parametrize("way", ["away", "towards"])
 def test_a_person_standing_still_is_turned_to_the_way_its_limbs_bend(standing_still, way):
-    """Nothing walks to say which way a still person faces; the twin test does (measured
-    on the person facing away: it starts facing the camera, 180 deg off, and is turned in
-    frame 35, after the first window of 1 s; the person facing the camera is never turned)."""
+    """Nothing walks to say which way a still person faces; the twin test does, over a new
+    person's first seconds (carry.start_twin_s, on by default) and all along (carry.twin,
+    off by default). Measured on the person facing away: it starts facing the camera, 180 deg
+    off, and is turned in frame 49 by the start's test (after its 1.5 s), in frame 42 by the
+    test all along (after its first window of 1 s); with neither it faces the camera all
+    along. The person facing the camera is never turned."""
     from occupose.run import track_frames
     from occupose.tracker import Tracker
 
     scene, rendered = standing_still[way]
     truth = _shoulder_heading(np.stack([f.joints[0] for f in rendered]))
     runs = {}
-    for twin in ((False, True) if way == "away" else (True,)):
-        tracker = Tracker(scene.cameras, scene.fps, TrackerConfig().with_values({"carry.twin": twin}), seed=0)
+    for name, values in (("neither", {"carry.start_twin_s": 0.0}), ("start", {}),
+                         ("all along", {"carry.start_twin_s": 0.0, "carry.twin": True})):
+        tracker = Tracker(scene.cameras, scene.fps, TrackerConfig().with_values(values), seed=0)
         joints = track_frames(tracker, rendered, len(rendered)).tracks[1][0]
         tracked = np.isfinite(joints[:, 0, 0])
         off = np.abs((_shoulder_heading(joints[tracked]) - truth[tracked] + np.pi) % (2 * np.pi) - np.pi)
-        runs[twin] = np.degrees(off)
+        runs[name] = np.degrees(off)
     if way == "away":
-        assert np.median(runs[False]) > 150  # without it: facing the camera all along
-        assert runs[True][0] > 150 and np.all(runs[True][-15:] < 30)
+        assert np.median(runs["neither"]) > 150
+        for name in ("start", "all along"):
+            assert runs[name][0] > 150 and np.all(runs[name][-15:] < 30), name
     else:
-        assert np.all(runs[True] < 30)
+        assert all(np.all(off < 30) for off in runs.values())
 
 
 def test_a_person_carried_into_space_a_camera_sees_through_stays():
