@@ -255,28 +255,30 @@ class Person:
 
     def settle_facing(self) -> None:
         """Settle the way a new person faces by its limbs: over its first
-        ``carry.start_twin_s`` seconds, until it walks faster than ``carry.walking_speed``,
-        compare its estimate with the estimate's twin every ``carry.twin_every`` estimates
-        (:meth:`_twin_gain`); then, with at least ``carry.start_twin_count`` comparisons,
-        go on with the twin when the t statistic of its gains (their mean over its standard
-        error) is at least ``carry.start_twin_t``, and keep the estimate when it is at most
-        minus that (the comparisons start again when the estimate is turned meanwhile,
-        :meth:`_turned`). The heading so
-        settled is kept (:meth:`_keeps_settled`) against the walk: neither the turn round
-        (:meth:`face_the_way_walked`) nor the walking prior act on a walk against it, so a
-        person who stood, and then walks backwards, is not turned to face the way it walks.
-        A person who does not walk may start facing either way (:func:`occupose.pose.start
-        .start_headings` keeps the half facing the camera), and walking says nothing about
-        one who walks backwards: on the randomized benchmark's walk-back clips the start
-        faced the wrong way and the twin explained better in 7 of 8 to 9 of 9 comparisons
-        before the walk began. A share of wins does not tell those from a gesturing person
-        faced the right way, whose twin won 9 of 15 by as much, but more noisily; their
-        gains' t statistic does (about 3 and 1; notes/2026-12-07-start-twin.md)."""
+        ``carry.start_twin_s`` seconds, until it walks faster than
+        ``carry.walking_speed`` (over its last ``carry.walk_frames`` estimates), compare
+        its estimate with the estimate's twin every ``carry.twin_every`` estimates
+        (:meth:`_twin_gain`); then, with at least ``carry.start_twin_count``
+        comparisons, go on with the twin when the t statistic of its gains (their mean
+        over its standard error) is at least ``carry.start_twin_t``, and keep the
+        estimate when it is at most minus that (the comparisons start again when the
+        estimate is turned meanwhile, :meth:`_turned`). The heading so settled is kept
+        (:meth:`_keeps_settled`) against the walk: neither the turn round
+        (:meth:`face_the_way_walked`) nor the walking prior act on a walk against it, so
+        a person who stood, and then walks backwards, is not turned to face the way it
+        walks. A person who does not walk may start facing either way
+        (:func:`occupose.pose.start.start_headings` keeps the half facing the camera),
+        and walking says nothing about one who walks backwards: on the randomized
+        benchmark's walk-back clips the start faced the wrong way and the twin explained
+        better in 7 of 8 to 9 of 9 comparisons before the walk began. A share of wins
+        does not tell those from a gesturing person faced the right way, whose twin won
+        9 of 15 by as much, but more noisily; their gains' t statistic does (about 3 and
+        1; notes/2026-12-07-start-twin.md)."""
         carry = self.config.carry
         if self.start_twins is None:
             return
-        moving = len(self.path) >= carry.frames and float(
-            np.hypot(*(self.path[-1] - self.path[0]))) / (len(self.path) - 1) * self.fps > carry.walking_speed
+        velocity = self._velocity()
+        moving = velocity is not None and float(np.hypot(*velocity)) > carry.walking_speed
         if not moving and self.estimates <= carry.start_twin_s * self.fps:
             if self.estimates % carry.twin_every == 0:
                 self.start_twins.append(self._twin_gain()[0])
