@@ -12,6 +12,7 @@ from occupose.camera import (
     camera_preset,
     look_at,
     pixels_from_points,
+    points_at_pixels,
     points_from_depth,
     raw_depth_from_metres,
     sensor_spec,
@@ -141,6 +142,20 @@ def test_points_from_depth_matches_a_per_pixel_reference(rng):
     points_f, pixels_f = points_from_depth(metres.astype(np.float64), camera)
     np.testing.assert_array_equal(pixels_f, pixels)
     np.testing.assert_allclose(points_f, points, atol=1e-12)
+
+
+def test_points_at_chosen_pixels_are_those_rows_of_points_from_depth(rng):
+    camera = small_camera(tilted_pose())
+    raw = rng.integers(500, 4000, size=(6, 8)).astype(np.uint16)
+    raw[rng.random((6, 8)) < 0.3] = 0
+    for depth in (raw, raw * np.float32(0.001)):
+        points, pixels = points_from_depth(depth, camera)
+        chosen = np.sort(rng.choice(pixels.size, 9, replace=False))
+        for frame in ("world", "camera"):
+            every, _ = points_from_depth(depth, camera, frame=frame)
+            np.testing.assert_array_equal(points_at_pixels(depth, pixels[chosen], camera, frame=frame), every[chosen])
+    with pytest.raises(ValueError, match="must be a"):
+        points_at_pixels(raw[:, :4], pixels, camera)
 
 
 def test_points_in_camera_frame_have_depth_as_z():

@@ -204,22 +204,27 @@ def _camera_points(depth: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.nd
     flat = depth.reshape(-1)
     if depth.dtype == np.uint16:
         pixels = np.flatnonzero(flat)
-        z = flat[pixels] * camera.depth_scale
     elif depth.dtype.kind == "f":
         with np.errstate(invalid="ignore"):
             pixels = np.flatnonzero(np.isfinite(flat) & (flat > 0))
-        z = flat[pixels].astype(np.float64)
     else:
         raise ValueError(
             f"depth image for camera {camera.name!r} must be uint16 raw values or float metres, got {depth.dtype}"
         )
     pixels = pixels.astype(np.int64, copy=False)
+    return _points_at(flat, pixels, camera), pixels
+
+
+def _points_at(flat: np.ndarray, pixels: np.ndarray, camera: Camera) -> np.ndarray:
+    """(N, 3) float64 camera-frame points of the measured pixels ``pixels`` ((N,) int64 flat
+    indices) of a depth image ``flat`` ((H * W,) uint16 raw or float metres)."""
+    z = flat[pixels] * camera.depth_scale if flat.dtype == np.uint16 else flat[pixels].astype(np.float64)
     v, u = np.divmod(pixels, camera.width)
     points = np.empty((pixels.size, 3))
     points[:, 0] = (u - camera.cx) * z / camera.fx
     points[:, 1] = (v - camera.cy) * z / camera.fy
     points[:, 2] = z
-    return points, pixels
+    return points
 
 
 def _check_frame(frame: str) -> None:
@@ -249,10 +254,33 @@ def points_from_depth(
     """
     _check_frame(frame)
     points, pixels = _camera_points(depth, camera)
+    return _in_frame(points, camera, frame), pixels
+
+
+def points_at_pixels(depth: np.ndarray, pixels: np.ndarray, camera: Camera, *, frame: str = "world") -> np.ndarray:
+    """The 3D points of chosen measured pixels of a depth image, as `points_from_depth` gives them.
+
+    depth : (H, W) uint16 raw values or float metres, H, W = camera.height, camera.width
+    pixels : (N,) int64 flat pixel indices ``v * W + u`` of pixels with a measurement (the
+        caller has checked: e.g. those whose point `cells_from_depth` put in a cell)
+    Returns (N, 3) float64, metres, in ``frame``: bit for bit the rows of
+    ``points_from_depth(depth, camera)`` at those pixels.
+    """
+    _check_frame(frame)
+    depth = np.asarray(depth)
+    if depth.shape != (camera.height, camera.width) or not (depth.dtype == np.uint16 or depth.dtype.kind == "f"):
+        raise ValueError(f"depth image for camera {camera.name!r} must be a ({camera.height}, {camera.width}) "
+                         f"uint16 or float image, got {depth.dtype} {depth.shape}")
+    pixels = np.asarray(pixels, np.int64)
+    return _in_frame(_points_at(depth.reshape(-1), pixels, camera), camera, frame)
+
+
+def _in_frame(points: np.ndarray, camera: Camera, frame: str) -> np.ndarray:
+    """(N, 3) camera-frame points in ``frame`` ("world" or "camera")."""
     if frame == "world":
         pose = camera.world_from_camera
         points = points @ pose[:3, :3].T + pose[:3, 3]
-    return points, pixels
+    return points
 
 
 def pixels_from_points(

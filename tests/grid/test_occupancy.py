@@ -419,6 +419,24 @@ def test_cells_from_depth_matches_numpy(rng):
     assert (plain >= 0).sum() > 200 and np.count_nonzero(moved != plain) > 50
     raw = np.round(np.nan_to_num(depth) * 1000).astype(np.uint16)
     assert np.mean(cells_from_depth(raw, cam, grid.spec) == plain) > 0.95
+    # only the points of claimed labels, and of cells within bounds, keep their cell
+    labels = rng.integers(0, 4, grid.spec.shape).astype(np.int32)
+    claims = np.array([0, 1, 0, 4], np.int64)
+    claimed = cells_from_depth(depth, cam, grid.spec, states, labels=labels, claims=claims)
+    expected = np.where((moved >= 0) & (claims[labels.reshape(-1)[moved]] > 0), moved, -1)
+    np.testing.assert_array_equal(claimed, expected)
+    assert 0 < np.count_nonzero(claimed >= 0) < np.count_nonzero(moved >= 0)
+    own = np.stack(np.unravel_index(np.maximum(plain, 0), grid.spec.shape), axis=-1)
+    low = np.median(own[plain >= 0], axis=0).astype(int) - 2
+    high = low + 4
+    inside = (plain >= 0) & np.all((own >= low) & (own <= high), axis=-1)
+    np.testing.assert_array_equal(cells_from_depth(depth, cam, grid.spec, states, within=(low, high)),
+                                  np.where(inside, moved, -1))
+    assert 0 < np.count_nonzero(inside) < np.count_nonzero(plain >= 0)
+    with pytest.raises(ValueError, match="together"):
+        cells_from_depth(depth, cam, grid.spec, labels=labels)
+    with pytest.raises(ValueError, match="every label"):
+        cells_from_depth(depth, cam, grid.spec, labels=labels, claims=claims[:2])
 
 
 def test_foreground_from_grid_takes_states_or_a_mask(rng):

@@ -285,19 +285,28 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, returnless, half_e
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def cells_from_pixels(depth, fx, fy, cx, cy, rotation, translation, origin, cell, nx, ny, nz, states, out):
+def cells_from_pixels(depth, fx, fy, cx, cy, rotation, translation, origin, cell, nx, ny, nz, bounds, states, labels,
+                      claims, out):
     """Flat cell index of every pixel's back-projected point, in place.
 
     depth : (H, W) float32 metres (<= 0 or not finite: no measurement)
     fx, fy, cx, cy : floats, pixels; rotation (3, 3), translation (3,) float64: world_from_camera
     origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
+    bounds : (2, 3) int64, the lowest and highest (i, j, k) of the cells looked at: a point
+        whose own cell is outside gets -1 (``[[0, 0, 0], [nx - 1, ny - 1, nz - 1]]`` for all)
     states : (N,) uint8 cell states, or an empty array; when given, a point in an E cell (2)
         moves to the O or M cell among the 26 around it whose centre is nearest (first in
         (di, dj, dk) lexicographic order on ties), if any
-    out : (H * W,) int64, -1 where there is no measurement or the point is outside the grid
+    labels : (N,) int32 label of each cell, and claims : (L,) int64, nonzero for the labels
+        wanted, or both empty arrays; when given, a point whose (moved) cell's label is not
+        claimed gets -1 (one pass where a gather of labels and claims per pixel took two
+        more over the image)
+    out : (H * W,) int64, -1 where there is no measurement, the point is outside the grid
+        or its cell is not claimed
     """
     height, width = depth.shape
     use_states = states.size > 0
+    use_claims = claims.size > 0
     for v in numba.prange(height):
         for u in range(width):
             p = v * width + u
@@ -313,7 +322,8 @@ def cells_from_pixels(depth, fx, fy, cx, cy, rotation, translation, origin, cell
             i = int(math.floor((px - origin[0]) / cell))
             j = int(math.floor((py - origin[1]) / cell))
             k = int(math.floor((pz - origin[2]) / cell))
-            if i < 0 or i >= nx or j < 0 or j >= ny or k < 0 or k >= nz:
+            if (i < bounds[0, 0] or i > bounds[1, 0] or j < bounds[0, 1] or j > bounds[1, 1] or k < bounds[0, 2]
+                    or k > bounds[1, 2]):
                 continue
             n = (i * ny + j) * nz + k
             if use_states and states[n] == 2:
@@ -334,6 +344,8 @@ def cells_from_pixels(depth, fx, fy, cx, cy, rotation, translation, origin, cell
                             if dist < best:
                                 best = dist
                                 n = m
+            if use_claims and claims[labels[n]] == 0:
+                continue
             out[p] = n
 
 

@@ -423,7 +423,9 @@ def _check_states(states: np.ndarray, spec: GridSpec) -> np.ndarray:
     return states
 
 
-def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: np.ndarray | None = None) -> np.ndarray:
+def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: np.ndarray | None = None, *,
+                     labels: np.ndarray | None = None, claims: np.ndarray | None = None,
+                     within: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The grid cell of every depth pixel's back-projected 3D point (the paper's Fig. 2(d)).
 
     depth : (H, W) float metres or uint16 raw, H, W = camera.height, camera.width (0 = no measurement)
@@ -432,8 +434,14 @@ def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: 
         centre passes beside the object, so the cell reads as seen through although the
         object covers part of it. With ``states``, such a point is given to the nearest
         (by centre distance) O or M cell among the 26 around its own, if there is one.
+    labels : optional (nx, ny, nz) int32 cell labels (`blobs_from_mask`), with ``claims``
+        (L,) int64 indexed by label, L > labels.max(): only the points whose cell's label
+        has a nonzero claim keep their cell (the others get -1).
+    within : optional ((3,), (3,)) int, the lowest and highest cell index (i, j, k) looked
+        at: a point whose own cell lies outside gets -1 (neither moved nor labelled).
     Returns (H, W) int64: flat cell index ``(i * ny + j) * nz + k`` into ``spec.shape``, -1
-    where there is no measurement or the point is outside the grid.
+    where there is no measurement, the point is outside the grid (or ``within``) or its label
+    is not claimed.
     """
     depth = np.asarray(depth)
     if depth.shape != (camera.height, camera.width):
@@ -445,11 +453,27 @@ def cells_from_depth(depth: np.ndarray, camera: Camera, spec: GridSpec, states: 
         raise ValueError(
             f"depth image for camera {camera.name!r} must be float metres or uint16 raw, got {depth.dtype}")
     states = np.zeros(0, np.uint8) if states is None else _check_states(states, spec).reshape(-1)
+    if (labels is None) != (claims is None):
+        raise ValueError("labels and claims go together: give both or neither")
+    if labels is None:
+        labels, claims = np.zeros(0, np.int32), np.zeros(0, np.int64)
+    else:
+        labels, claims = np.asarray(labels), np.asarray(claims)
+        if labels.shape != spec.shape or labels.dtype != np.int32:
+            raise ValueError(f"labels must be an int32 {spec.shape} array, got {labels.dtype} {labels.shape}")
+        if claims.ndim != 1 or claims.dtype != np.int64 or claims.size <= max(int(labels.max(initial=0)), 0):
+            raise ValueError(f"claims must be an int64 array over every label (more than {labels.max(initial=0)}), "
+                             f"got {claims.dtype} {claims.shape}")
+        labels = np.ascontiguousarray(labels).reshape(-1)
+    bounds = np.array([[0, 0, 0], np.subtract(spec.shape, 1)], np.int64)
+    if within is not None:
+        bounds = np.array(within, np.int64).reshape(2, 3)
     out = np.empty(camera.height * camera.width, np.int64)
     pose = camera.world_from_camera
     _kernels.cells_from_pixels(np.ascontiguousarray(depth, np.float32), camera.fx, camera.fy, camera.cx, camera.cy,
                                np.ascontiguousarray(pose[:3, :3]), pose[:3, 3].copy(), np.asarray(spec.origin),
-                               spec.cell, *spec.shape, states, out)
+                               spec.cell, *spec.shape, np.clip(bounds, 0, np.subtract(spec.shape, 1)), states, labels,
+                               claims, out)
     return out.reshape(camera.height, camera.width)
 
 

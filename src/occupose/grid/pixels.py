@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from occupose.camera import Camera, pixels_from_points, points_from_depth
+from occupose.camera import Camera, pixels_from_points, points_at_pixels
 from occupose.config import PixelsConfig
 from occupose.grid.blobs import Blob
 from occupose.grid.occupancy import E, M, cells_from_depth
@@ -201,11 +201,13 @@ def pixels_from_depth(
     if states is None:
         states = np.where(labels > 0, M, E).astype(np.uint8)
     codes = _label_codes(labels, tracks, ids)
-    label_of_cell = np.append(labels.reshape(-1), 0)  # index -1 (no cell) reads the appended 0
+    labels = labels.astype(np.int32, copy=False)
+    label_of_cell = labels.reshape(-1)
     # the tracks' cells and their neighbours (a point in an empty cell may join one): only
     # the pixels in each camera's window of that box can be anyone's
     low = np.min([b.low for b in tracks.values()], axis=0) - spec.cell
     high = np.max([b.high for b in tracks.values()], axis=0) + spec.cell
+    within = (np.rint((low - spec.origin) / spec.cell), np.rint((high - spec.origin) / spec.cell) - 1)  # its cells
     for camera in cameras:
         depth = np.asarray(depths[camera.name])
         if depth.shape != (camera.height, camera.width):
@@ -215,12 +217,11 @@ def pixels_from_depth(
         window = depth[v0:v1, u0:u1]
         cropped = replace(camera, width=u1 - u0, height=v1 - v0, cx=camera.cx - u0,
                           cy=camera.cy - v0)  # the same rays: (u - u0) - (cx - u0) is u - cx exactly
-        cell = cells_from_depth(window, cropped, spec, states).reshape(-1)
-        label = label_of_cell[cell]
-        label[codes[label] == 0] = 0
-        points, local = points_from_depth(np.where(label.reshape(window.shape) > 0, window, 0), cropped)
+        cell = cells_from_depth(window, cropped, spec, states, labels=labels, claims=codes, within=within).reshape(-1)
+        local = np.flatnonzero(cell >= 0)  # the window's pixels in a tracked blob's cells
+        points = points_at_pixels(window, local, cropped)
         pixels = (local // cropped.width + v0) * camera.width + local % cropped.width + u0
-        code = codes[label[local]]
+        code = codes[label_of_cell[cell[local]]]
         owner = np.zeros(pixels.size, np.int64)
         for k, tid in enumerate(ids):
             owner[code == (np.int64(1) << k)] = tid
