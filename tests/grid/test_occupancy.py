@@ -380,11 +380,15 @@ def test_projection_tables_match_numpy(cameras):
     models = dict(zip([c.name for c in cameras], ("structured_light", "tof")))
     grid = OccupancyGrid(spec, cameras, models)
     pixels, depths, widths, ambiguous = reference_tables(grid)
-    assert grid._pixels.shape == grid._depths_l.shape == grid._widths.shape == pixels.shape
+    assert grid._pixels.shape == grid._depths_l.shape == pixels.shape
     assert ambiguous.mean() < 0.001
     np.testing.assert_allclose(grid._depths_l, depths, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(grid._pixels[~ambiguous], pixels[~ambiguous])
-    np.testing.assert_array_equal(grid._widths[~ambiguous], widths[~ambiguous])
+    # the tail widths the kernel looks up from the depths (tail_width_at), where there is a pixel
+    found = grid._pixels >= 0
+    looked_up = np.column_stack([grid.tail_width * grid.depth_noise(grid._depths_l[:, c], cam.name)
+                                 for c, cam in enumerate(grid.cameras)])
+    np.testing.assert_array_equal(looked_up[found & ~ambiguous], widths[found & ~ambiguous])
     for c in range(len(cameras)):
         behind, found = depths[:, c] <= 0, pixels[:, c] >= 0
         assert behind.sum() > 100 and found.sum() > 100 and (~behind & ~found).sum() > 100
@@ -397,10 +401,10 @@ def test_memory_estimate_counts_what_the_grid_keeps(cameras):
     grid = OccupancyGrid(spec, cameras)
     arrays = [v for v in vars(grid).values() if isinstance(v, np.ndarray)]
     per_cell = [v.nbytes for v in arrays if v.shape[0] in (spec.num_cells, spec.shape[0]) and v.size >= spec.num_cells]
-    assert len(per_cell) == 7  # beliefs, states, visibility, skip codes; pixels, depths, widths
+    assert len(per_cell) == 6  # beliefs, states, visibility, skip codes; pixels, depths
     assert sum(per_cell) == spec.num_cells * (GRID_BYTES_PER_CELL + TABLE_BYTES_PER_CELL * len(cameras))
-    assert bytes_per_cell(len(cameras)) == BYTES_PER_CELL  # the coverage check's peak, up to two cameras
-    assert bytes_per_cell(3) == GRID_BYTES_PER_CELL + 3 * TABLE_BYTES_PER_CELL == 76
+    assert bytes_per_cell(len(cameras)) == bytes_per_cell(4) == BYTES_PER_CELL  # the coverage check's peak
+    assert bytes_per_cell(5) == GRID_BYTES_PER_CELL + 5 * TABLE_BYTES_PER_CELL == 76
 
 
 def test_cells_from_depth_matches_numpy(rng):

@@ -1,8 +1,8 @@
 """Numba kernels of the occupancy grid (private: use :class:`occupose.grid.occupancy.OccupancyGrid`).
 
 The cameras do not move, so where a cell centre falls in each image is found once, when
-the grid is made (:func:`pixels_from_cells`: each cell's pixel, its depth along the
-optical axis and the observation function's tail width there, per camera). Then one
+the grid is made (:func:`pixels_from_cells`: each cell's pixel and its depth along the
+optical axis, per camera). Then one
 fused kernel does a whole frame (:func:`update_grid`): for every cell (in parallel over
 x slices, without the GIL) it reads the depth pixel of the cell centre in each camera,
 evaluates the observation function, runs one forward step of the cell's three-state
@@ -73,25 +73,19 @@ def observation(epsilon, half_extent, width, p_occ, p_free):
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
-def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, sigma_lut, lut_step,
-                      tail_width, pixels, depths_l, widths):
+def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrinsics, sizes, pixels, depths_l):
     """Where every cell centre falls in every camera's image, in place (once per grid: the
     cameras do not move).
 
     origin : (3,) float64 metres; cell : float metres; nx, ny, nz : int cell counts
     rotations (C, 3, 3), translations (C, 3), intrinsics (C, 4) float64; sizes (C, 2) int64
-    sigma_lut (C, L) float64 metres; lut_step float metres; tail_width : float, noise stds
     pixels : (N, C) int32 out, the flat pixel index ``v * width + u`` of cell n's centre in
         camera c's image, -1 where the centre is behind the camera or outside the image
     depths_l : (N, C) float64 out, metres, the centre's depth along the optical axis
         (``column + k * cell * rotation`` from the centre of cell (i, j, 0): update_grid's
         results depend on these exact values)
-    widths : (N, C) float64 out, metres, the observation function's tail width
-        ``tail_width * sigma_lut[c, min(int(depth_l / lut_step), L - 1)]`` (0 where pixel is -1)
     """
     num_cameras = rotations.shape[0]
-    lut_last = sigma_lut.shape[1] - 1
-    lut_scale = 1.0 / lut_step
     for i in numba.prange(nx):
         x = origin[0] + cell * (i + 0.5)
         column = np.empty((num_cameras, 3))  # camera-frame centre of cell (i, j, k)
@@ -110,7 +104,6 @@ def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrins
                     depth_l = column[c, 2] + k * cell * rotations[c, 2, 2]
                     depths_l[n, c] = depth_l
                     pixels[n, c] = -1
-                    widths[n, c] = 0.0
                     if depth_l <= 0.0:
                         continue
                     inverse = 1.0 / depth_l
@@ -119,7 +112,16 @@ def pixels_from_cells(origin, cell, nx, ny, nz, rotations, translations, intrins
                     if u < 0 or u >= sizes[c, 0] or v < 0 or v >= sizes[c, 1]:
                         continue
                     pixels[n, c] = int(v) * sizes[c, 0] + int(u)
-                    widths[n, c] = tail_width * sigma_lut[c, min(int(depth_l * lut_scale), lut_last)]
+
+
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
+def tail_width_at(depth_l, sigma_lut, c, lut_scale, tail_width):
+    """The observation function's tail width (metres) for camera ``c`` at depth ``depth_l``
+    (metres): ``tail_width`` times the noise tabulated in ``sigma_lut`` ((C, L) metres) at
+    ``int(depth_l * lut_scale)`` (the last entry beyond). One multiplication on each side of
+    the look-up: found where it is needed, it is the same number every time (a table of
+    it cost 8 bytes per cell and camera to read every frame)."""
+    return tail_width * sigma_lut[c, min(int(depth_l * lut_scale), sigma_lut.shape[1] - 1)]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -141,14 +143,16 @@ def count_missing(depth, run, after, returnless):
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy", fastmath={"contract", "arcp", "nsz"})
-def update_grid(nx, pixels, depths_l, widths, offsets, depth, returnless, half_extents, fars, p_occ, p_free,
-                no_return, transition, held, hold, flush, probabilities, states, visibility, quiet):
+def update_grid(nx, pixels, depths_l, sigma_lut, lut_step, tail_width, offsets, depth, returnless, half_extents, fars,
+                p_occ, p_free, no_return, transition, held, hold, flush, probabilities, states, visibility, quiet):
     """One frame of the grid, in place; returns the number of cells whose HMM step ran.
 
     nx : int, the grid's x slices (run in parallel; the N cells are nx slices of N / nx)
-    pixels (N, C) int32, depths_l (N, C) float64 metres, widths (N, C) float64 metres: each
-        cell centre's pixel in each camera's image (-1: none), depth along its optical axis
-        and tail width, from :func:`pixels_from_cells`
+    pixels (N, C) int32, depths_l (N, C) float64 metres: each cell centre's pixel in each
+        camera's image (-1: none) and depth along its optical axis, from :func:`pixels_from_cells`
+    sigma_lut (C, L) float64 metres, each camera's depth noise at depth ``m * lut_step``;
+        lut_step : float metres; tail_width : float, noise stds: the observation function's
+        tail width at a cell (:func:`tail_width_at`)
     offsets (C,) int64; depth (sum H*W,) float32 metres (<= 0 or not finite: no measurement)
     returnless (sum H*W,) bool: pixels that have measured nothing for long enough to count as
         no return (:meth:`occupose.grid.occupancy.OccupancyGrid.update`)
@@ -177,6 +181,7 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, returnless, half_e
     """
     num_cameras = pixels.shape[1]
     slice_cells = pixels.shape[0] // nx
+    lut_scale = 1.0 / lut_step
     use_hold = hold.size > 0
     use_quiet = num_cameras <= QUIET_CAMERAS
     t_oo, t_om, t_oe = transition[0, 0], transition[0, 1], transition[0, 2]
@@ -212,7 +217,9 @@ def update_grid(nx, pixels, depths_l, widths, offsets, depth, returnless, half_e
                             code += NO_RETURN * power_c
                     continue
                 covered = True
-                f, kind = observation(d - depths_l[n, c], half_extents[c], widths[n, c], p_occ, p_free)
+                depth_l = depths_l[n, c]
+                f, kind = observation(d - depth_l, half_extents[c], tail_width_at(depth_l, sigma_lut, c, lut_scale,
+                                                                                   tail_width), p_occ, p_free)
                 if kind != BEHIND:
                     seen = True
                 if kind == TAIL:

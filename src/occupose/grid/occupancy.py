@@ -165,8 +165,8 @@ BYTES_PER_CELL = 72
 #: Bytes per cell an :class:`OccupancyGrid` keeps: the (O, M, E) beliefs (3 float32), the
 #: state, the visibility and the kernel's skip code (uint16).
 GRID_BYTES_PER_CELL = 16
-#: ... and per cell and camera: the cell centre's pixel (int32), depth and tail width (float64).
-TABLE_BYTES_PER_CELL = 20
+#: ... and per cell and camera: the cell centre's pixel (int32) and depth (float64).
+TABLE_BYTES_PER_CELL = 12
 #: Posterior probabilities below this are set to 0 (float32 never goes subnormal).
 FLUSH = 1e-30
 _LUT_STEP = 0.01
@@ -395,8 +395,8 @@ def spec_from_cameras(cameras: Sequence[Camera], cell: float = 0.05, height: flo
 def bytes_per_cell(num_cameras: int) -> int:
     """Peak bytes per cell of making and updating a grid seen by ``num_cameras`` cameras:
     the larger of the coverage check's :data:`BYTES_PER_CELL` and what the grid keeps,
-    :data:`GRID_BYTES_PER_CELL` + :data:`TABLE_BYTES_PER_CELL` per camera (72 B up to two
-    cameras, 76 B for three, 96 B for four; each camera's image adds 4 bytes a pixel)."""
+    :data:`GRID_BYTES_PER_CELL` + :data:`TABLE_BYTES_PER_CELL` per camera (72 B up to four
+    cameras, 76 B for five; each camera's image adds 4 bytes a pixel)."""
     return max(BYTES_PER_CELL, GRID_BYTES_PER_CELL + TABLE_BYTES_PER_CELL * int(num_cameras))
 
 
@@ -565,7 +565,7 @@ class OccupancyGrid:
     def _camera_arrays(self) -> None:
         """Per-camera arrays of the kernel, and where every cell centre falls in every image
         (module docstring of occupose.grid._kernels): the cameras do not move, so each cell's
-        pixel, depth and tail width are found once, here."""
+        pixel and depth are found once, here."""
         count = len(self.cameras)
         rotations = np.empty((count, 3, 3))
         translations = np.empty((count, 3))
@@ -594,14 +594,13 @@ class OccupancyGrid:
         self._missing_run = np.zeros(offset, np.uint16)
         self._returnless = np.zeros(offset, np.bool_)
         num_cells = self.spec.num_cells
-        #: (N, C) each cell centre's flat pixel index in each image (-1: none), its depth along
-        #: the optical axis (metres) and the observation function's tail width there (metres).
+        #: (N, C) each cell centre's flat pixel index in each image (-1: none) and its depth
+        #: along the optical axis (metres); the tail width there is looked up from it
+        #: (_kernels.tail_width_at)
         self._pixels = np.empty((num_cells, count), np.int32)
         self._depths_l = np.empty((num_cells, count))
-        self._widths = np.empty((num_cells, count))
         _kernels.pixels_from_cells(np.asarray(self.spec.origin), self.spec.cell, *self.spec.shape, rotations,
-                                   translations, intrinsics, sizes, self._sigma_lut, _LUT_STEP, self.tail_width,
-                                   self._pixels, self._depths_l, self._widths)
+                                   translations, intrinsics, sizes, self._pixels, self._depths_l)
 
     def depth_noise(self, depth_l, camera: str) -> np.ndarray:
         """The depth noise (one standard deviation, metres) the grid assumes for camera ``camera``
@@ -657,8 +656,9 @@ class OccupancyGrid:
             cell in its parallel loop.
 
         Runs one fused numba kernel over all cells (it releases the GIL, so another thread
-        can work meanwhile); it reads each cell centre's pixel, depth and tail width per
-        camera from tables made with the grid (20 bytes per cell and camera). A cell's HMM step is skipped where it would change nothing: the
+        can work meanwhile); it reads each cell centre's pixel and depth per camera from
+        tables made with the grid (12 bytes per cell and camera), and the tail width there
+        from the noise table. A cell's HMM step is skipped where it would change nothing: the
         cell is not held, its last step left its probabilities bit for bit as they were, and
         every camera observes it as then with the same value of the observation function
         (seen through beyond the tails, on the surface, hidden beyond the tails, or not
@@ -678,7 +678,8 @@ class OccupancyGrid:
         if self.no_return < 1.0:
             _kernels.count_missing(self._depth, self._missing_run, self.no_return_after, self._returnless)
         self.stepped = _kernels.update_grid(
-            self.spec.shape[0], self._pixels, self._depths_l, self._widths, self._offsets, self._depth,
+            self.spec.shape[0], self._pixels, self._depths_l, self._sigma_lut, _LUT_STEP, self.tail_width,
+            self._offsets, self._depth,
             self._returnless, self._half_extents, self._fars, self.p_occ, self.p_free, self.no_return, self.transition,
             self.held_transition, hold, FLUSH,
             self._probabilities.reshape(-1, 3), self._states.reshape(-1), self._visibility.reshape(-1), self._quiet,
