@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from benchmarks import (
+    bench_against,
     bench_bag,
     bench_blobs,
     bench_body,
@@ -26,7 +27,7 @@ from benchmarks import (
 )
 
 BENCHMARKS = [bench_render, bench_grid, bench_blobs, bench_body, bench_likelihood, bench_filters, bench_tracking, bench_speed, bench_stages, bench_startup,
-              bench_robustness, bench_fit, bench_bag, bench_mkv]
+              bench_robustness, bench_fit, bench_bag, bench_mkv, bench_against]
 
 
 def machine() -> str:

@@ -29,7 +29,9 @@ TITLE = "Tracker speed: frames/s of `occupose track` (ours), start-up excluded, 
 NUM_FRAMES = 300
 
 
-def _three_people():
+def three_people():
+    """``two_people_crossing`` with the walker of ``no_occlusion`` walking between the two
+    (procedural motion): the three-people scene of the speed benchmarks."""
     scene = build_scenario("two_people_crossing", use_mocap=False)
     walker = build_scenario("no_occlusion", use_mocap=False).people[0]
     joints = walker.joints[: scene.num_frames].copy()
@@ -40,7 +42,7 @@ def _three_people():
 def _scenes():
     yield "sit_behind_table", build_scenario("sit_behind_table", use_mocap=False)
     yield "two_people_crossing", build_scenario("two_people_crossing", use_mocap=False)
-    yield "three_people", _three_people()
+    yield "three_people", three_people()
 
 
 def run() -> list[dict]:
