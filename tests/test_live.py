@@ -30,6 +30,12 @@ SHARED_BAG = Path(__file__).resolve().parents[2] / "shared" / "data" / "sensors"
 FRAMES = 45  # 1.5 s at 30 frames/s
 
 
+def tracked_lines(text: str) -> tuple[list[dict], list[dict]]:
+    """A live run's JSON lines: (one per tracked frame, the look-back's late lines)."""
+    lines = [json.loads(line) for line in text.splitlines()]
+    return [line for line in lines if not line.get("late")], [line for line in lines if line.get("late")]
+
+
 @pytest.fixture(scope="module")
 def walk_bag(tmp_path_factory):
     """A RealSense bag of no_occlusion's first frames (a person walking in view from the
@@ -56,7 +62,7 @@ def test_a_synthetic_bag_plays_as_a_camera_and_counts_what_it_drops(walk_bag):
         assert camera.fx == pytest.approx(scene.cameras[0].fx, rel=1e-6)
         assert camera.depth_scale == pytest.approx(scene.cameras[0].depth_scale, rel=1e-6)
         summary = track_live(source, "ours", out=out, pose=pose, status=said.append)
-    lines = [json.loads(line) for line in out.getvalue().splitlines()]
+    lines, _ = tracked_lines(out.getvalue())
     numbers = [line["device_frame"] for line in lines]
     # the bag's first frame (those played before it is held for the warm-up wait in a queue),
     # then always newer ones
@@ -76,19 +82,31 @@ def test_a_bag_played_frame_by_frame_tracks_every_frame_and_its_person(walk_bag)
     out = io.StringIO()
     with RealSenseCamera(bag=bag, real_time=False) as source:
         summary = track_live(source, "ours", out=out, pose=pose)
-    lines = [json.loads(line) for line in out.getvalue().splitlines()]
+    lines, late = tracked_lines(out.getvalue())
     assert [line["device_frame"] for line in lines] == list(range(1, FRAMES + 1))
     assert summary.dropped == 0 and all(line["dropped"] == 0 for line in lines)
     truth = scene.people[0].joints
-    errors = []
-    for line in lines:
-        assert len(line["people"]) <= 1
-        for person in line["people"]:
-            assert len(person["joints"]) == len(person["visible"]) == 15
-            pelvis = np.array(person["joints"][JOINT_INDEX["pelvis"]])
-            errors.append(np.linalg.norm(pelvis - truth[line["device_frame"] - 1, JOINT_INDEX["pelvis"]]))
+
+    def pelvis_errors(lines):
+        errors = []
+        for line in lines:
+            assert len(line["people"]) <= 1
+            for person in line["people"]:
+                assert len(person["joints"]) == len(person["visible"]) == 15
+                pelvis = np.array(person["joints"][JOINT_INDEX["pelvis"]])
+                errors.append(np.linalg.norm(pelvis - truth[line["device_frame"] - 1, JOINT_INDEX["pelvis"]]))
+        return errors
+
+    errors = pelvis_errors(lines)
     assert len(errors) >= 0.8 * FRAMES  # tracked from its first frames
     assert np.median(errors) < 0.06, errors  # metres (3.1 cm when written, the same on a busy machine)
+    # the look-back's late lines: the frames before the person's first line, each once, its
+    # own number and time, the person as in occupose track's output
+    first = next(line["frame"] for line in lines if line["people"])
+    assert late and [line["frame"] for line in late] == list(range(first - len(late), first))
+    assert all(line["device_frame"] == line["frame"] + 1 and "latency_ms" not in line for line in late)
+    assert {line["time_ms"] for line in late} <= {line["time_ms"] for line in lines}
+    assert np.median(pelvis_errors(late)) < 0.1
 
 
 def test_live_measures_the_noise_on_the_first_frames_it_tracks(walk_bag):
@@ -99,7 +117,7 @@ def test_live_measures_the_noise_on_the_first_frames_it_tracks(walk_bag):
     with RealSenseCamera(bag=bag, real_time=False) as source:
         summary = track_live(source, method_config("ours").with_values({"grid.noise_frames": 5}), out=out,
                              pose=pose, status=said.append)
-    lines = [json.loads(line) for line in out.getvalue().splitlines()]
+    lines, _ = tracked_lines(out.getvalue())
     assert said[0] == "the camera's depth noise is measured on its first 5 frames tracked"
     assert [line["device_frame"] for line in lines[:5]] == [1, 2, 3, 4, 5]  # tracked, not set aside
     assert summary.noise["model"] == "measured" and summary.noise["frames"] == 5
@@ -116,7 +134,7 @@ def test_a_tracker_slower_than_the_camera_drops_frames_and_says_so(walk_bag):
     with RealSenseCamera(bag=bag) as source:
         summary = track_live(source, method_config("ours").with_values({"pose.particles": 2000}), out=out,
                              pose=pose, status=said.append)
-    lines = [json.loads(line) for line in out.getvalue().splitlines()]
+    lines, _ = tracked_lines(out.getvalue())
     assert summary.dropped > 0 and summary.frames < FRAMES
     assert summary.frames + summary.dropped == lines[-1]["device_frame"] - lines[0]["device_frame"] + 1
     assert f"{summary.dropped} dropped" in said[-1]
@@ -129,7 +147,7 @@ def test_live_on_the_command_line_writes_json_lines_and_refuses_to_overwrite(wal
             "--frames", "5"]
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 0, result.output
-    lines = [json.loads(line) for line in out.read_text().splitlines()]
+    lines, _ = tracked_lines(out.read_text())
     assert len(lines) == 5 and "5 frames tracked" in result.output and "the pose given" in result.output
     again = CliRunner().invoke(main, args)
     assert again.exit_code != 0 and "exists" in again.output
@@ -141,12 +159,12 @@ def test_live_on_the_command_line_writes_json_lines_and_refuses_to_overwrite(wal
     assert theirs.read_text() == "my notes\n"
     floor = CliRunner().invoke(main, [*args[:4], "--out", str(tmp_path / "floor.jsonl"), "--frames", "5"])
     assert floor.exit_code == 0, floor.output  # no pose given: the floor of the first frames places it
-    tracked = len((tmp_path / "floor.jsonl").read_text().splitlines())  # 5, or fewer where the bag ends first
+    tracked = len(tracked_lines((tmp_path / "floor.jsonl").read_text())[0])  # 5, or fewer where the bag ends first
     assert "placed from the floor" in floor.output and 1 <= tracked <= 5 and f"{tracked} frames tracked" in floor.output
     every = tmp_path / "every.jsonl"
     played = CliRunner().invoke(main, [*args[:5], str(every), *args[6:], "--every-frame"])
     assert played.exit_code == 0, played.output
-    assert [json.loads(line)["device_frame"] for line in every.read_text().splitlines()] == [1, 2, 3, 4, 5]
+    assert [line["device_frame"] for line in tracked_lines(every.read_text())[0]] == [1, 2, 3, 4, 5]
     camera = CliRunner().invoke(main, ["live", "--realsense", "--every-frame", "--out", str(tmp_path / "c.jsonl")])
     assert camera.exit_code != 0 and "--every-frame plays a --bag" in camera.output
 

@@ -8,8 +8,10 @@ taken. A bag can also be played at the tracker's pace (``real_time=False``,
 machine's load. :func:`track_live` tracks them one after another, always the newest. When
 the tracking falls behind, the frames it had no time for are dropped, counted from the gaps
 in the device's frame numbers and reported. Every tracked frame gives one JSON line
-(:func:`frame_record`), flushed at once, and a status line on stderr about every second
-says the frames, drops, latency and people.
+(:func:`frame_record`), flushed at once, followed by late lines for the earlier frames the
+look-back has just tracked a new person back into (:func:`late_records`; a line is never
+rewritten), and a status line on stderr about every second says the frames, drops,
+latency and people.
 
 Latency is the time from a frame's capture to its JSON line. The capture time is the
 frame's device timestamp placed on the host clock by the least delayed frame so far (the
@@ -24,7 +26,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
@@ -156,12 +158,36 @@ def frame_record(index: int, frame: LiveFrame, estimates, latency_ms: float, dro
     person ``track`` and ``joints`` (15 x [x, y, z] metres in the world frame, in the order
     of :data:`occupose.joints.JOINTS`, null where the model reports none) and ``visible``
     (15 booleans: estimated from this frame's data)."""
+    return {"frame": index, "device_frame": frame.number, "time_ms": round(frame.time_ms, 3),
+            "latency_ms": round(latency_ms, 2), "dropped": dropped, "people": _people(estimates)}
+
+
+def late_records(index: int, looked_back, recent: Mapping[int, LiveFrame]) -> list[dict]:
+    """The JSON lines of the look-back's estimates made at tracked frame ``index``
+    (``FrameResult.looked_back``: {track: [(frames ago, PersonEstimate)]}): one per earlier
+    frame, oldest first, with ``frame``, ``device_frame`` and ``time_ms`` of that frame (from
+    ``recent``: tracked frame -> its LiveFrame), ``late`` true and the ``people`` tracked
+    back in it, as in :func:`frame_record`. A reader that merges the lines of a frame gets
+    what ``occupose track`` writes for it."""
+    by_frame: dict[int, dict] = {}
+    for track, earlier in looked_back.items():
+        for ago, estimate in earlier:
+            by_frame.setdefault(index - ago, {})[track] = estimate
+    lines = []
+    for earlier_index in sorted(by_frame):
+        frame = recent[earlier_index]
+        lines.append({"frame": earlier_index, "device_frame": frame.number, "time_ms": round(frame.time_ms, 3),
+                      "late": True, "people": _people(by_frame[earlier_index])})
+    return lines
+
+
+def _people(estimates) -> list[dict]:
+    """``people`` of a JSON line: {track: PersonEstimate} in track order."""
     people = []
     for track, estimate in sorted(estimates.items()):
         joints = [[round(float(c), 4) for c in j] if np.all(np.isfinite(j)) else None for j in estimate.joints]
         people.append({"track": int(track), "joints": joints, "visible": [bool(v) for v in estimate.visible]})
-    return {"frame": index, "device_frame": frame.number, "time_ms": round(frame.time_ms, 3),
-            "latency_ms": round(latency_ms, 2), "dropped": dropped, "people": people}
+    return people
 
 
 @dataclass
@@ -210,7 +236,8 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
                seed: int = 0, max_frames: int | None = None, status: Callable[[str], None] | None = None
                ) -> LiveSummary:
     """Track ``source``'s frames as they come, writing one JSON line per tracked frame to
-    ``out`` (:func:`frame_record`, flushed each time).
+    ``out`` (:func:`frame_record`), then a late line for each earlier frame the look-back
+    tracked a new person back into (:func:`late_records`), flushed each time.
 
     pose : a HeightTilt, a pose file, or None (the floor in the first frames)
     max_frames : stop after this many tracked frames (None: until the source ends)
@@ -230,6 +257,9 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
     tracker = Tracker([camera], source.fps, config, seed=seed)
     source.resume()
     summary = LiveSummary(pose=origin)
+    # the tracked frames the look-back may reach: their numbers and times for its late lines
+    recent: dict[int, LiveFrame] = {}
+    reach = round(config.start.look_back_s * source.fps) + config.start.look_back_from + 1
     offset = math.inf  # host clock minus device clock (s), least over the frames: the least delayed one's
     last_status = time.perf_counter()
     for frame in frames:
@@ -239,7 +269,11 @@ def track_live(source: RealSenseCamera, config: TrackerConfig | str = "ours", *,
         summary.dropped += frame.dropped  # the first: those that came during the floor estimate and warm-up
         result = tracker.update({camera.name: frame.depth})
         latency = 1000.0 * (time.perf_counter() - (frame.time_ms / 1000.0 + offset))
-        out.write(json.dumps(frame_record(summary.frames, frame, result.estimates, latency, summary.dropped)) + "\n")
+        recent[summary.frames] = frame
+        recent.pop(summary.frames - reach, None)
+        lines = [frame_record(summary.frames, frame, result.estimates, latency, summary.dropped)]
+        lines += late_records(summary.frames, result.looked_back, recent)
+        out.write("".join(json.dumps(line) + "\n" for line in lines))
         out.flush()
         summary.frames += 1
         summary.latencies.append(latency)
