@@ -189,7 +189,32 @@ def tables(results: dict[str, list[Run]]) -> str:
                 if figures is not None:
                     rows.append([bucket, label] + [_cell(fmt, figures[k]) for _, k, fmt in COLUMNS])
         sections.append(f"#### {'overall' if key is None else 'by ' + key}\n\n" + markdown_table(headings, rows))
+    sections.append(fails_table(results))
     return "\n".join(sections)
+
+
+#: A FAIL with at most this many of the 15 joints visible where it trips is counted as "mostly hidden".
+MOSTLY_HIDDEN_JOINTS = 9
+
+
+def fails_table(results: dict[str, list[Run]]) -> str:
+    """Markdown: where each FAIL trips (robustness.PersonRun's fail_frame, visible_at_fail,
+    missed_before_fail), a row per FAILing person-run, and how many were mostly hidden
+    (at most MOSTLY_HIDDEN_JOINTS joints visible there) or mostly without an estimate
+    (half the window or more)."""
+    headings = ["code", "scene", "seed", "person", "mean [cm]", "trips at frame", "joints visible there",
+                "window without estimate [%]"]
+    rows, counts = [], []
+    for label, runs in results.items():
+        fails = [p for run in runs for p in run.persons if p.fail and p.fail_frame is not None]
+        rows += [[label, p.scene, str(p.seed), str(p.person), _cell("{:.1f}", p.mean_cm), str(p.fail_frame),
+                  str(p.visible_at_fail), f"{100 * p.missed_before_fail:.0f}"] for p in fails]
+        hidden = sum(p.visible_at_fail <= MOSTLY_HIDDEN_JOINTS for p in fails)
+        missed = sum(p.missed_before_fail >= 0.5 for p in fails)
+        counts.append(f"{label}: {len(fails)} FAILs, {hidden} with at most {MOSTLY_HIDDEN_JOINTS} of 15 joints "
+                      f"visible where they trip, {missed} without an estimate in half their window or more")
+    return ("#### FAILs: where the rule trips\n\n" + "; ".join(counts) + ".\n\n"
+            + (markdown_table(headings, rows) if rows else ""))
 
 
 def _cell(fmt: str, value) -> str:

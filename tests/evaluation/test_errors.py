@@ -8,6 +8,7 @@ import pytest
 from occupose.evaluation.errors import (
     MISSED_ERROR_M,
     fail_curve,
+    fail_frame,
     frame_errors,
     is_fail,
     joint_errors,
@@ -147,6 +148,11 @@ def test_sustained_error_fails():
     errors[30:] = 0.30
     assert is_fail(errors, 10.0)
     assert not is_fail(errors, 10.0, threshold_m=0.30)
+    # the rule trips where the 20-frame window's mean first exceeds 25 cm:
+    # (20 - n) * 0.10 + n * 0.30 > 0.25 * 20 for n > 15 frames at 30 cm, i.e. at frame 45
+    assert fail_frame(errors, 10.0) == 45
+    assert fail_frame(errors, 10.0, threshold_m=0.30) is None
+    assert fail_frame(np.full(60, 0.05), 10.0) is None
 
 
 def test_grace_period_then_windows_include_the_first_second():

@@ -61,6 +61,18 @@ def test_score_run_counts_switches_lasting_tracks_and_a_missed_person():
     found, missed = alone.persons
     assert found.mean_cm == pytest.approx(100 * 0.03 * math.sqrt(3)) and found.within10 == 100.0
     assert missed.fail and missed.coverage == 0.0 and missed.within10 == 0.0 and math.isnan(missed.mean_cm)
+    # where the FAILs trip: the missed person at the end of the 1 s grace period, wholly
+    # without an estimate; a found person has no FAIL to place
+    assert (missed.fail_frame, missed.visible_at_fail, missed.missed_before_fail) == (10, 15, 1.0)
+    assert found.fail_frame is found.visible_at_fail is found.missed_before_fail is None
+    late = gt[:, 0] + 0.03
+    late[25:, :, 0] += 0.5  # 50 cm off along x from frame 25, while only 4 joints show
+    partly = visible.copy()
+    partly[25:, 0, 4:] = False
+    drifted = score_run("scene", 0, {}, gt, partly, {1: late}, FPS).persons[0]
+    # frames of 5.2 cm and of 53.2 cm (0.53 along x, 0.03 across): the 20-frame window's mean
+    # passes 25 cm with n of the latter once 1.04 + 0.480 n > 5 m, n = 9: at frame 33
+    assert (drifted.fail_frame, drifted.visible_at_fail, drifted.missed_before_fail) == (33, 4, 0.0)
     text = json.dumps(alone.as_dict())
     assert json.dumps(run_from_dict(json.loads(text)).as_dict()) == text  # NaN != NaN: compared as JSON
     unseen = visible.copy()
@@ -128,3 +140,17 @@ def test_a_tiny_benchmark_run_scores_a_rendered_scene(tmp_path):
     markdown = write(results, tmp_path, "note").read_text()
     assert "#### by view" in markdown and "| front | current | 1 | 1 |" in markdown
     assert json.loads((tmp_path / "robustness.json").read_text())[CURRENT][0]["scene"] == "no_occlusion"
+
+
+def test_the_fails_table_places_each_fail_and_counts_the_hidden_and_the_missed():
+    from benchmarks.bench_robustness import fails_table
+    from occupose.evaluation.robustness import PersonRun, Run
+
+    def person(index, fail, frame=None, shown=None, missed=None):
+        return PersonRun("s", 0, index, 20.0, 50.0, 40.0, 90.0, fail, 0, frame, shown, missed)
+
+    runs = [Run("s", 0, {}, 3, 3, (person(0, True, 30, 3, 1.0), person(1, True, 97, 12, 0.2), person(2, False)))]
+    text = fails_table({"current": runs})
+    assert "current: 2 FAILs, 1 with at most 9 of 15 joints visible where they trip, 1 without an estimate" in text
+    assert "| current | s | 0 | 0 | 20.0 | 30 | 3 | 100 |" in text and "| current | s | 0 | 1 | 20.0 | 97 | 12 | 20 |" in text
+    assert sum(line.startswith("| current |") for line in text.splitlines()) == 2  # not the person who passed

@@ -17,6 +17,7 @@ Table I rows of every ground-truth person.
 from occupose.evaluation.errors import (
     TableRow,
     fail_curve,
+    fail_frame,
     frame_errors,
     is_fail,
     joint_errors,
@@ -57,7 +58,7 @@ from occupose.evaluation.report import (
 
 __all__ = [
     # errors
-    "TableRow", "fail_curve", "frame_errors", "is_fail", "joint_errors", "per_joint_errors", "rolling_mean",
+    "TableRow", "fail_curve", "fail_frame", "frame_errors", "is_fail", "joint_errors", "per_joint_errors", "rolling_mean",
     "table_row",
     # matching
     "PersonScore", "Score", "evaluated_joints", "identity_switches", "match_tracks", "person_errors",

@@ -251,9 +251,25 @@ def is_fail(
     Parameters as in `fail_curve`; ``threshold_m`` in metres, compared strictly (a
     rolling mean of exactly 25 cm does not FAIL).
     """
+    return fail_frame(frame_errors, fps, missed=missed, window_s=window_s, threshold_m=threshold_m,
+                      after_s=after_s) is not None
+
+
+def fail_frame(
+    frame_errors: Any,
+    fps: float,
+    *,
+    missed: Any = None,
+    window_s: float = 2.0,
+    threshold_m: float = 0.25,
+    after_s: float = 1.0,
+) -> int | None:
+    """The first frame at which the FAIL rule trips (the rolling mean of `fail_curve`
+    exceeds ``threshold_m``), or None for no FAIL. Parameters as in `is_fail`."""
     threshold_m = positive_float(threshold_m, "threshold_m")
     curve = fail_curve(frame_errors, fps, missed=missed, window_s=window_s, after_s=after_s)
-    return bool(np.any(curve[~np.isnan(curve)] > threshold_m))
+    over = np.flatnonzero(np.nan_to_num(curve, nan=0.0) > threshold_m)
+    return int(over[0]) if over.size else None
 
 
 # --------------------------------------------------------------------------- Table I
@@ -273,6 +289,8 @@ class TableRow:
         (missed frames count in ``over20``); NaN when no frame counts.
     fail : bool
         The automatic FAIL status (`is_fail`).
+    fail_frame : int or None
+        The first frame at which the FAIL rule trips (`fail_frame`), None without a FAIL.
     frames : int
         Counted frames (ground truth has the person).
     coverage : float
@@ -288,6 +306,7 @@ class TableRow:
     fail: bool
     frames: int
     coverage: float
+    fail_frame: int | None = None
 
     def format(self) -> str:
         """One-line summary, e.g. ``avg 12.34 cm, std 5.67 cm, <10 20.00 %, ..., ok, 300 frames``."""
@@ -318,7 +337,7 @@ def table_row(frame_errors: Any, fps: float, *, missed: Any = None) -> TableRow:
     TableRow (definitions in the module docstring).
     """
     values = _frame_values(frame_errors, missed)
-    fail = is_fail(frame_errors, fps, missed=missed)
+    tripped = fail_frame(frame_errors, fps, missed=missed)
     estimated = values[np.isfinite(values)]
     frames = int(np.count_nonzero(~np.isnan(values)))
     if estimated.size:
@@ -335,7 +354,7 @@ def table_row(frame_errors: Any, fps: float, *, missed: Any = None) -> TableRow:
     return TableRow(
         mean_cm=mean_cm, std_cm=std_cm,
         under10=under[0], under15=under[1], under20=under[2], over20=over,
-        fail=fail, frames=frames, coverage=percent(estimated.size),
+        fail=tripped is not None, frames=frames, coverage=percent(estimated.size), fail_frame=tripped,
     )
 
 

@@ -165,7 +165,8 @@ def table_i_markdown(
 
 def mean_row(rows: Sequence[TableRow]) -> TableRow:
     """The mean of Table I rows over runs: each number averaged over the runs that have
-    it (NaN when none does), FAIL when any run FAILs, frames rounded."""
+    it (NaN when none does), FAIL when any run FAILs (at the earliest run's FAIL frame),
+    frames rounded."""
     if not rows:
         raise ValueError("mean_row needs at least one row")
     values = {}
@@ -173,6 +174,8 @@ def mean_row(rows: Sequence[TableRow]) -> TableRow:
         column = [getattr(r, f.name) for r in rows]
         if f.name == "fail":
             values[f.name] = any(column)
+        elif f.name == "fail_frame":  # the earliest FAIL among the runs
+            values[f.name] = min((v for v in column if v is not None), default=None)
         elif f.name == "frames":
             values[f.name] = int(round(float(np.mean(column))))
         else:

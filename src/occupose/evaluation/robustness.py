@@ -17,6 +17,12 @@ coverage
     Percent of counted frames that are estimated.
 fail
     The automatic FAIL rule of occupose.evaluation.errors (``is_fail``).
+fail_frame, visible_at_fail, missed_before_fail
+    Where a FAIL trips (None without one): the first frame at which the rule trips
+    (``fail_frame`` of errors), the person's ground-truth-visible joints in that frame
+    (of 15: a person mostly hidden, or entering or leaving the image, shows few), and the
+    share of the counted frames of the rule's window ending there (``FAIL_WINDOW_S``) that
+    have no estimate (a person not yet started, or lost).
 switches
     Identity switches of the person (matching.identity_switches).
 
@@ -58,6 +64,8 @@ CONDITION_FILES = ("scene.json", "render.json", "recording.json")
 TOP_VIEW_PITCH_DEG = 60.0
 #: A numeric condition with more distinct values than this is bucketed in this many bins of about equal counts.
 NUMERIC_BINS = 3
+#: The FAIL rule's window (occupose.evaluation.errors.fail_curve's default), seconds.
+FAIL_WINDOW_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -73,6 +81,9 @@ class PersonRun:
     coverage: float
     fail: bool
     switches: int
+    fail_frame: int | None = None
+    visible_at_fail: int | None = None
+    missed_before_fail: float | None = None
 
 
 @dataclass(frozen=True)
@@ -157,12 +168,27 @@ def score_run(scene: str, seed: int, conditions: Mapping[str, Any], gt_joints: A
             scene=scene, seed=seed, person=index, mean_cm=row.mean_cm, under20=row.under20,
             within10=within_share(gt_joints[:, index][:, evaluated], visible, est[:, evaluated]),
             coverage=row.coverage, fail=row.fail, switches=person.identity_switches,
+            **_where_it_fails(row.fail_frame, gt_joints[:, index][:, evaluated], gt_visible[:, index],
+                              est[:, evaluated], fps),
         ))
     people = int(np.count_nonzero(present >= lasting))
     reported = [int(np.count_nonzero(np.any(np.all(np.isfinite(np.asarray(t)), axis=2), axis=1)))
                 for t in tracks.values()]
     return Run(scene=scene, seed=seed, conditions=dict(conditions), people=people,
                tracks=sum(frames >= lasting for frames in reported), persons=tuple(persons))
+
+
+def _where_it_fails(frame: int | None, gt_joints: np.ndarray, gt_visible: np.ndarray, est: np.ndarray,
+                    fps: float) -> dict[str, Any]:
+    """PersonRun's fail_frame, visible_at_fail and missed_before_fail (module docstring) of
+    one person: gt_joints, est (T, E, 3) metres over the evaluated joints, gt_visible (T, 15)."""
+    if frame is None:
+        return {}
+    counted = np.any(np.all(np.isfinite(gt_joints), axis=2), axis=1) & np.any(gt_visible, axis=1)
+    missed = counted & ~np.any(np.all(np.isfinite(est), axis=2), axis=1)
+    window = slice(max(0, frame + 1 - int(round(FAIL_WINDOW_S * fps))), frame + 1)
+    return {"fail_frame": frame, "visible_at_fail": int(np.count_nonzero(gt_visible[frame])),
+            "missed_before_fail": float(missed[window].sum() / max(1, counted[window].sum()))}
 
 
 def recording_conditions(folder: str | Path, cameras: Sequence[Any], num_people: int) -> dict[str, Any]:
