@@ -32,6 +32,7 @@ import numpy as np
 
 from occupose.body.model import TRANSLATION, BodyModel
 from occupose.config import DiffusionConfig
+from occupose.geometry.angles import wrap_angle
 
 #: Diffusion standard deviation per frame at 30 frames/s by DOF kind, metres or radians.
 DIFFUSION_30FPS: dict[str, float] = dataclasses.asdict(DiffusionConfig())
@@ -72,10 +73,6 @@ def diffusion_scales(model: BodyModel, fps: float = 30.0, scale: float = 1.0, *,
         elif kind in overrides:
             out[i] = overrides[kind]
     return out
-
-
-def _wrap(values):
-    return (values + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def _reflect(values: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -139,7 +136,7 @@ def diffuse(poses, scales, limits, rng: np.random.Generator, *, periodic=None, m
         out = np.where(periodic, out, np.clip(out, lo, hi))
     else:
         out = np.where(periodic, out, _reflect(out, lo, hi))
-    out[:, periodic] = _wrap(out[:, periodic])
+    out[:, periodic] = wrap_angle(out[:, periodic])
     return out
 
 
@@ -161,5 +158,5 @@ def root_drift(model: BodyModel, previous, current, damping: float = 1.0) -> np.
     root = model.dof_type == TRANSLATION
     drift[root] = damping * (current[root] - previous[root])
     turn = model.periodic
-    drift[turn] = damping * ((current[turn] - previous[turn] + math.pi) % (2 * math.pi) - math.pi)
+    drift[turn] = damping * wrap_angle(current[turn] - previous[turn])
     return drift

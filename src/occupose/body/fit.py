@@ -17,6 +17,7 @@ from scipy.optimize import least_squares
 
 from occupose.body.kinematics import joints_from_poses
 from occupose.body.model import BodyModel
+from occupose.geometry.angles import wrap_angle
 from occupose.joints import JOINT_INDEX as J
 from occupose.joints import MIRRORED, NUM_JOINTS
 
@@ -62,7 +63,7 @@ def _limb(parent: np.ndarray, root, mid, end, s: float, leg: bool, limits: np.nd
     a = parent.T @ _unit(mid - root)
     abd = math.asin(float(np.clip(s * a[1], -1.0, 1.0)))
     flex = math.atan2(a[0], -a[2])
-    candidates = [(flex, abd), (float(_wrap(flex + math.pi)), math.pi - abd)]
+    candidates = [(flex, abd), (float(wrap_angle(flex + math.pi)), math.pi - abd)]
     flex, abd = min(candidates, key=lambda c: float(np.sum(np.maximum(limits[:, 0] - c, 0.0)
                                                             + np.maximum(np.subtract(c, limits[:, 1]), 0.0))))
     frame = parent @ _rot(1, -flex) @ _rot(0, s * abd)
@@ -115,14 +116,10 @@ def _analytic(model: BodyModel, joints: np.ndarray) -> np.ndarray:
     return pose
 
 
-def _wrap(angles):
-    return (np.asarray(angles) + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def _inside(model: BodyModel, pose: np.ndarray) -> np.ndarray:
     """The pose with periodic DOFs wrapped and the others clipped just inside their limits."""
     pose = pose.copy()
-    pose[model.periodic] = _wrap(pose[model.periodic])
+    pose[model.periodic] = wrap_angle(pose[model.periodic])
     lo, hi = model.limits[:, 0], model.limits[:, 1]
     margin = 1e-6 * (hi - lo)
     free = ~model.periodic

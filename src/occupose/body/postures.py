@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from occupose.body.model import BodyModel
+from occupose.geometry.angles import wrap_angle
 
 #: Arms hanging relaxed: shoulder flex, abd, rot, elbow (radians).
 ARM_REST = np.array([0.0, 0.12, 0.0, 0.15])
@@ -33,7 +34,7 @@ def _base(model: BodyModel, xy, heading: float) -> np.ndarray:
         raise ValueError(f"xy must be two finite numbers (metres) and heading finite radians, got {xy!r}, {heading!r}")
     pose = np.zeros(model.num_dofs)
     pose[model.dof("x")], pose[model.dof("y")] = xy
-    pose[model.dof("heading")] = (heading + math.pi) % (2 * math.pi) - math.pi
+    pose[model.dof("heading")] = wrap_angle(heading)
     for side in ("left", "right"):
         for name, value in zip(_ARM, ARM_REST):
             pose[model.dof(f"{side}_{name}")] = value

@@ -1,1 +1,1 @@
-"""Solid shape primitives and ray casting, shared by the scene renderer and the likelihoods."""
+"""Solid shape primitives, ray casting and angles, shared by the scene renderer, the body model and the likelihoods."""

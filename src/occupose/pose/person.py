@@ -36,6 +36,7 @@ from occupose.camera import Camera
 from occupose.config import TrackerConfig
 from occupose.filters import filter_options
 from occupose.filters.layered import spread_layers
+from occupose.geometry.angles import wrap_angle
 from occupose.grid.pixels import PersonPixels
 from occupose.grid.tracking import TrackState
 from occupose.likelihood import Observation, observation_from_views, point_distances
@@ -249,7 +250,7 @@ class Person:
         if len(self.path) < carry.frames or not self._upright(carry.frames):
             return False
         velocity = (self.path[-1] - self.path[0]) / (len(self.path) - 1) * self.fps * self._time
-        off = _wrapped(np.arctan2(velocity[1], velocity[0]) - facing)
+        off = wrap_angle(np.arctan2(velocity[1], velocity[0]) - facing)
         fast = carry.walking_speed if self.estimates <= carry.start_check_s * self.fps else carry.later_speed
         return bool(np.hypot(*velocity) > fast and abs(off) > np.deg2rad(carry.backwards_deg))
 
@@ -296,7 +297,7 @@ class Person:
     def _keeps_settled(self) -> bool:
         """Whether the estimate still faces within a quarter turn of the heading settled by
         :meth:`settle_facing` (else that heading is dropped: the person turned)."""
-        if self.settled is not None and abs(_wrapped(self.pose[self.problem.heading_dof] - self.settled)) > np.pi / 2:
+        if self.settled is not None and abs(wrap_angle(self.pose[self.problem.heading_dof] - self.settled)) > np.pi / 2:
             self.settled = None
         return self.settled is not None
 
@@ -485,7 +486,7 @@ class Person:
         if speed <= carry.walk_from or not self._upright(carry.walk_frames):
             return None
         direction = float(np.arctan2(velocity[1], velocity[0]))
-        if self._keeps_settled() and abs(_wrapped(direction - self.pose[self.problem.heading_dof])) > np.deg2rad(
+        if self._keeps_settled() and abs(wrap_angle(direction - self.pose[self.problem.heading_dof])) > np.deg2rad(
                 carry.backwards_deg):
             return None
         return direction, carry.walk_prior * min(1.0, (speed - carry.walk_from) / carry.walk_ramp)
@@ -619,8 +620,3 @@ class Person:
             return point_distances(a, b, radii, points, sort=False)[0][0].astype(np.float64)
 
         return distance
-
-
-def _wrapped(angle: float) -> float:
-    """``angle`` (rad) wrapped into [-pi, pi)."""
-    return (angle + np.pi) % (2 * np.pi) - np.pi

@@ -21,6 +21,7 @@ from occupose.body import body_model, dims_from_observation
 from occupose.body.size import breadth_profile, neck_and_shoulders, top_height
 from occupose.camera import Camera, points_from_depth
 from occupose.config import SizeConfig, StartConfig, TrackerConfig
+from occupose.geometry.angles import wrap_angle
 from occupose.grid.blobs import blobs_from_mask
 from occupose.grid.occupancy import O, cells_from_depth
 from occupose.grid.pixels import PersonPixels
@@ -125,7 +126,7 @@ def start_headings(velocity: np.ndarray, centroid: np.ndarray, camera: Camera, c
     else:
         to_camera = camera.world_from_camera[:2, 3] - centroid[:2]
         facing = np.arctan2(to_camera[1], to_camera[0])
-    off = (headings - facing + np.pi) % (2 * np.pi) - np.pi
+    off = wrap_angle(headings - facing)
     return headings[np.abs(off) < np.pi / 2 + 1e-9]
 
 

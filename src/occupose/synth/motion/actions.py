@@ -16,6 +16,7 @@ import numpy as np
 
 from occupose.body.dims import DEFAULT_DIMS, BodyDims
 from occupose.body.postures import ARM_REST
+from occupose.geometry.angles import wrap_angle
 from occupose.synth.motion.pose import (
     ELBOW, HEADING, HIP_FLEX, LEFT, NECK_FLEX, POSE_SIZE, RIGHT, SHOULDER_ABD, SHOULDER_FLEX, SHOULDER_ROT,
     STAND_KNEE, TRUNK_LEAN, TRUNK_SIDE, TRUNK_TWIST, X, Y, Z, _ankles, _check_pose, _frame, _hip_height_limit, _hips,
@@ -41,10 +42,6 @@ def _smootherstep(x):
 def _bump(x):
     """0 -> 1 -> 0 on [0, 1] (sin^2), zero slope at both ends."""
     return np.sin(np.pi * np.clip(x, 0.0, 1.0)) ** 2
-
-
-def _wrap(angle):
-    return (angle + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def _check_positive(name: str, value, unit: str) -> float:
@@ -219,7 +216,7 @@ def walk(start, path_xy, speed: float = 1.3, *, dims: BodyDims = DEFAULT_DIMS, f
     fps = _check_positive("fps", fps, "frames per second")
     _require(start, dims, "walk", sitting=False)
     line = _centreline(_walk_points(start, path_xy))
-    delta = float(_wrap(start[HEADING] - line.heading[0]))
+    delta = float(wrap_angle(start[HEADING] - line.heading[0]))
     if abs(delta) > TURN_BEFORE_WALK:
         turned = turn(start, start[HEADING] - delta, dims=dims, fps=fps)
         return np.concatenate([turned, _walk(turned[-1], line, speed, 0.0, dims, fps)])
@@ -330,7 +327,7 @@ def turn(start, to_heading: float, duration: float | None = None, *, dims: BodyD
     if not math.isfinite(to_heading):
         raise ValueError(f"to_heading must be finite radians, got {to_heading!r}")
     _require(start, dims, "turn", sitting=False)
-    delta = float(_wrap(to_heading - start[HEADING]))
+    delta = float(wrap_angle(to_heading - start[HEADING]))
     t = _times(0.5 + 0.6 * abs(delta) if duration is None else duration, fps)
     total = t[-1]
     k = (dims.thigh + dims.shin) / 0.84
