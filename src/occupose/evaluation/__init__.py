@@ -58,8 +58,8 @@ from occupose.evaluation.report import (
 
 __all__ = [
     # errors
-    "TableRow", "fail_curve", "fail_frame", "frame_errors", "is_fail", "joint_errors", "per_joint_errors", "rolling_mean",
-    "table_row",
+    "TableRow", "fail_curve", "fail_frame", "frame_errors", "is_fail", "joint_errors", "per_joint_errors",
+    "rolling_mean", "table_row",
     # matching
     "PersonScore", "Score", "evaluated_joints", "identity_switches", "match_tracks", "person_errors",
     "score",
