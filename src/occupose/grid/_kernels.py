@@ -4,9 +4,8 @@ The cameras do not move, so where a cell centre falls in each image is found onc
 the grid is made (:func:`pixels_from_cells`: each cell's pixel and its depth along the
 optical axis, per camera). Then one fused kernel does a whole frame (:func:`update_grid`):
 for every cell (in parallel over x slices, without the GIL) it reads the depth pixel of
-the cell centre in each camera,
-evaluates the observation function, runs one forward step of the cell's three-state
-HMM, and writes the MAP state and the cell's visibility.
+the cell centre in each camera, evaluates the observation function, runs one forward step
+of the cell's three-state HMM, and writes the MAP state and the cell's visibility.
 
 Conventions shared with the wrapper:
 
