@@ -320,3 +320,27 @@ def test_a_blob_of_scattered_pixels_does_not_start(tracking, monkeypatch):
     assert not _tries_to_start(tracking, monkeypatch, ghost, 1.5)
     assert _tries_to_start(tracking, monkeypatch, observation, 1.5)
 
+
+
+def test_pixels_without_a_reading_for_long_enough_are_seen_through_by_the_pose_stage():
+    """pose.no_return_seen: a pixel the grid counts as returning nothing (no reading for
+    grid.no_return_after frames in a row) reads, for the pose stage, as the camera's far
+    range, so a body part drawn over it is in free space; a dropout of one frame does not."""
+    scenario = build_scenario("no_occlusion", use_mocap=False)
+    camera = scenario.cameras[0]
+    config = TrackerConfig.from_dict({"method": "ours", "pose": {"no_return_seen": True},
+                                      "grid": {"noise_model": "preset"}})
+    tracker = Tracker(scenario.cameras, scenario.fps, config, seed=0)
+    after = config.grid.no_return_after
+    for index, frame in enumerate(frames(scenario, seed=0, num_frames=after + 1)):
+        depth = frame.depth[camera.name].copy()
+        depth[:40] = 0.0  # a band beyond range from the first frame
+        if index == after:
+            depth[300, 300] = 0.0  # one frame's dropout
+        tracker.update({camera.name: depth})
+    seen = tracker._seen_depths({camera.name: depth})[camera.name]
+    far = np.float32(tracker.grid.max_ranges[camera.name])
+    assert np.all(seen[:40] == far) and seen[300, 300] == 0.0
+    np.testing.assert_array_equal(seen[40:], depth[40:])
+    plain = Tracker(scenario.cameras, scenario.fps, config.with_values({"pose.no_return_seen": False}), seed=0)
+    assert plain._seen_depths({camera.name: depth})[camera.name] is depth

@@ -418,6 +418,9 @@ class PoseConfig(_Section):
     shuffle: bool = setting(True, "part-based filter: shuffle the parts' resampled values among particles")
     part_weights: str = setting("chain", "part-based filter: what weights each part", choices=PART_WEIGHT_NAMES)
     likelihood: str = setting("points+free", "observation model", choices=LIKELIHOOD_NAMES)
+    no_return_seen: bool = setting(False, "a pixel that has measured nothing for grid.no_return_after frames in a "
+                                          "row counts, for the pose stage, as seeing through to the camera's far "
+                                          "range (a body part drawn over it is in free space)")
     max_points: int = setting(1000, "most observed points per person and frame given to the likelihood", "points",
                               low=1)
     gate_m: float = setting(0.25, "points farther than this from the predicted body are left out", "m", above=0)

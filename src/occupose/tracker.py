@@ -173,6 +173,19 @@ class Tracker:
         for person in self.people.values():
             person.area = self._area()
 
+    def _seen_depths(self, depths: Mapping[str, np.ndarray]) -> Mapping[str, np.ndarray]:
+        """The depths the pose stage reads (camera name -> (H, W) float32 metres): ``depths``,
+        or with ``pose.no_return_seen`` the pixels the grid counts as returning nothing
+        (``OccupancyGrid.returnless``) at the camera's far range, so that a body part drawn
+        over a background beyond the sensor's range is seen through."""
+        if not self.config.pose.no_return_seen:
+            return depths
+        out = {}
+        for cam in self.cameras:
+            depth = np.asarray(depths[cam.name], np.float32)
+            out[cam.name] = np.where(self.grid.returnless(cam.name), np.float32(self.grid.max_ranges[cam.name]), depth)
+        return out
+
     def _area(self) -> tuple[np.ndarray, np.ndarray]:
         """(low (2,), high (2,)) world x, y metres: the grid's floor area (Person's ``area``)."""
         return np.asarray(self.spec.origin[:2], float), self.spec.high[:2]
@@ -217,6 +230,7 @@ class Tracker:
         self._seed_still(depths, self.frame)
         if self._noise_frames is not None:  # (no grid job meanwhile: held is this frame's)
             self._measure_noise(depths, held)
+        seen_depths = self._seen_depths(depths)  # (before the next frame's grid job starts)
         clock = _tick(seconds, "grid", clock)
         blobs = self.config.blobs
         labels, found = blobs_from_mask(self.grid.moving_mask(), self.spec, min_cells=blobs.min_cells,
@@ -247,9 +261,9 @@ class Tracker:
         for tid in seen:
             if tid in owner:
                 pid = owner[tid]
-                out[pid] = self.people[pid].update(pixels[tid], depths, assigned, states[tid])
+                out[pid] = self.people[pid].update(pixels[tid], seen_depths, assigned, states[tid])
             else:
-                person = self._start(tid, pixels[tid], depths, seen[tid].centroid, states[tid].velocity)
+                person = self._start(tid, pixels[tid], seen_depths, seen[tid].centroid, states[tid].velocity)
                 if person is not None:
                     out[tid] = person.estimate(True)
                     if self._look_back.enabled:
@@ -257,10 +271,10 @@ class Tracker:
         looked_back = {}
         if self._look_back.enabled:
             looked_back = self._look_back.remember(self.frame, self.people, seen, owner, self._fragments, states,
-                                                   pixels, depths, assigned)
+                                                   pixels, seen_depths, assigned)
         for pid, person in self.people.items():
             if pid not in out:  # gone (behind something): kept, not estimated
-                person.carry(depths)
+                person.carry(seen_depths)
                 out[pid] = person.estimate(False)
         _tick(seconds, "pose", clock)
         return FrameResult(dict(sorted(out.items())), looked_back, assigned, seconds)

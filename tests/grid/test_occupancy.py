@@ -290,6 +290,8 @@ def test_only_pixels_missing_for_no_return_after_frames_count_as_no_return(rng):
         expected = reference_update(grid, frame, expected.astype(np.float32), returnless=returnless)[0]
         grid.update(frame)
         assert_same_beliefs(grid, expected)
+        for name, mask in returnless.items():  # the grid's own, as the pose stage reads it
+            np.testing.assert_array_equal(grid.returnless(name), mask)
     # the setup's holes (missing in every frame) count from frame 3, the persistent ones from
     # frame 5; a flickering pixel rarely misses 4 frames in a row (1 in 81)
     holes = {name: ~((d > 0) & np.isfinite(d)) for name, d in depths.items()}

@@ -686,6 +686,15 @@ class OccupancyGrid:
         )
         self.num_updates += 1
 
+    def returnless(self, camera: str) -> np.ndarray:
+        """(H, W) bool copy: the pixels of camera ``camera`` that have measured nothing for
+        ``no_return_after`` frames in a row, as of the last :meth:`update` (all False with
+        ``no_return`` 1, where they are not counted)."""
+        c = self._camera_index(camera)
+        cam = self.cameras[c]
+        start = self._offsets[c]
+        return self._returnless[start:start + cam.width * cam.height].reshape(cam.height, cam.width).copy()
+
     @property
     def states(self) -> np.ndarray:
         """(nx, ny, nz) uint8 MAP state per cell: O, M or E (read-only view)."""
